@@ -1,0 +1,20 @@
+#include <CLI/CLI.hpp>
+#include <cstdio>
+#include <exception>
+
+#include "mirror_lut_command.hpp"
+
+int main(int argc, char **argv) {
+  CLI::App app{"omnislam: omnidirectional stereo SLAM tools"};
+  app.require_subcommand(1);
+  omnislam::app::add_mirror_lut_command(app);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError &error) {
+    return app.exit(error);
+  } catch (const std::exception &error) {
+    std::fprintf(stderr, "omnislam: error: %s\n", error.what());
+    return 1;
+  }
+  return 0;
+}

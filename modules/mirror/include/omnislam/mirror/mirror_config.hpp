@@ -1,0 +1,42 @@
+#pragma once
+
+/// @file
+/// Camera and double-lobed mirror description (mirror.md sec. 0-1).
+/// Defaults are the thesis camera and mirror as rendered by scripts/render-dataset, so every
+/// command works on a rendered image without a configuration file.
+
+namespace omnislam::mirror {
+
+/// One hyperbolic lobe, given in the camera frame: the camera pinhole F0 is the origin and
+/// z points up along the optical axis. The lobe is a hyperbola with foci F0 and F (the focus
+/// may be off the axis, which tilts the lobe by beta = atan2(r_focus, z_focus)), revolved
+/// about the camera axis. The remaining constants (c, b, k, beta) are derived in double
+/// precision so the model is exactly self-consistent (mirror.md sec. 7, point 6).
+struct LobeConfig {
+  double focus_r_mm = 0.0;  ///< horizontal offset of the lobe's focus from the camera axis
+  double focus_z_mm = 0.0;  ///< height of the lobe's focus above the pinhole
+  double a_mm = 0.0;        ///< semi-major axis of the hyperbola
+};
+
+/// Camera intrinsics plus the mirror. All lengths in millimetres because the thesis's
+/// tables are; the model's public functions speak metres.
+struct MirrorConfig {
+  int image_width_px = 1024;
+  int image_height_px = 1024;
+  double center_u_px = 511.5;  ///< optical axis, pixel centres at integers
+  double center_v_px = 511.5;
+  double focal_mm = 25.0;
+  double pixel_pitch_mm = 3.5945 / 512.0;
+
+  LobeConfig inner{0.0, 270.300, 123.794};     ///< thesis table 1.1
+  LobeConfig outer{25.756, 420.300, 193.610};  ///< thesis table 1.1
+
+  /// Radial bins [0, discard_px) are dropped; the inner lobe uses the next rows_per_lobe
+  /// bins and the outer lobe the rows_per_lobe after those (thesis: 62 | 225 | 225).
+  int discard_px = 62;
+  int rows_per_lobe = 225;
+  int columns = 360;                ///< panorama columns, one per 360/columns degrees
+  double azimuth_offset_deg = 0.0;  ///< shifts the azimuth origin (thesis Anguloajuste)
+};
+
+}  // namespace omnislam::mirror
