@@ -1,0 +1,54 @@
+#pragma once
+
+#include <Eigen/Core>
+#include <cstddef>
+#include <memory>
+#include <optional>
+#include <vector>
+
+/// @file
+/// A 2D point set with a k-d tree (nanoflann) for nearest-neighbour and radius queries.
+
+namespace omnislam::slam {
+
+using Point2 = Eigen::Vector2d;
+using Points2 = std::vector<Point2>;
+
+struct Neighbor {
+  std::size_t index = 0;
+  double distance_sq_m2 = 0.0;
+};
+
+/// Owns its points and an index built once in the constructor. Move-only; not thread-safe
+/// (normals are computed lazily).
+class NearestNeighbors {
+ public:
+  explicit NearestNeighbors(Points2 points = {});
+  ~NearestNeighbors();
+  NearestNeighbors(NearestNeighbors &&) noexcept;
+  NearestNeighbors &operator=(NearestNeighbors &&) noexcept;
+  NearestNeighbors(const NearestNeighbors &) = delete;
+  NearestNeighbors &operator=(const NearestNeighbors &) = delete;
+
+  [[nodiscard]] const Points2 &points() const { return points_; }
+
+  /// Unit normal of the local line through each point (PCA of its neighbours within
+  /// 0.15 m), or zero where fewer than 3 points lie there. Computed on first use.
+  [[nodiscard]] const Points2 &normals() const;
+  [[nodiscard]] bool empty() const { return points_.empty(); }
+
+  /// Nearest point within `radius_m` of `query`, or nullopt (also for an empty set).
+  [[nodiscard]] std::optional<Neighbor> nearest(const Point2 &query, double radius_m) const;
+
+  /// Number of points within `radius_m` of `query` (the query itself counts if present).
+  [[nodiscard]] std::size_t count_within(const Point2 &query, double radius_m) const;
+
+ private:
+  struct Index;
+  Points2 points_;
+  std::unique_ptr<Index> index_;
+  mutable Points2 normals_;
+  mutable bool normals_ready_ = false;
+};
+
+}  // namespace omnislam::slam

@@ -1,0 +1,56 @@
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <cstddef>
+
+#include "omnislam/slam/nearest_neighbors.hpp"
+
+/// @file
+/// Trimmed ICP in 2D (Chetverikov et al. 2002; thesis sec. 5.1): registers a moving
+/// "sample" point set onto a static "model" set, trimming to the best `overlap` share of
+/// the pairs at every iteration.
+
+namespace omnislam::slam {
+
+/// Error metric of the pairs.
+enum class IcpMetric {
+  kPointToPoint,  ///< the thesis: Horn's closed form on point pairs (optionally with scale)
+  kPointToLine,   ///< Gauss-Newton on the distance to the model's local line: no bias from
+                  ///< the two scans sampling a wall at different places, and faster convergence
+};
+
+struct TrimmedIcpConfig {
+  IcpMetric metric = IcpMetric::kPointToLine;
+  double initial_search_radius_m = 0.5;  ///< dmax of the first iteration (thesis: 500 mm)
+  double min_search_radius_m = 0.02;     ///< floor for the shrinking dmax
+  double overlap = 0.7;                  ///< xi: share of sample points kept (thesis: 0.7)
+  int max_iterations = 30;               ///< thesis results chapter
+  double target_error_m2 = 1e-8;         ///< stop when the trimmed mean squared distance reaches it
+  double min_relative_change = 1e-4;     ///< stop when e changes less than this between iterations
+  bool estimate_scale = false;           ///< point-to-point only: also estimate a scale (thesis)
+  bool keep_global_minimum = true;       ///< return the best iterate if the last is > 10% worse
+};
+
+struct TrimmedIcpResult {
+  Eigen::Isometry2d T_model_sample = Eigen::Isometry2d::Identity();  ///< applied to sample points
+  double scale = 1.0;                                                ///< 1 unless estimate_scale
+  bool valid = false;      ///< false when too few pairs were ever found
+  bool converged = false;  ///< stopped by a criterion, not by the iteration cap
+  int iterations = 0;
+  double first_error_m2 = 0.0;  ///< e of the first iteration (trimmed mean squared residual)
+  double final_error_m2 = 0.0;  ///< e at the returned transform
+  double srel_percent = 0.0;    ///< 100 (e_first - e_final) / e_first (thesis "Srel")
+  std::size_t sample_points = 0;
+  std::size_t kept_pairs = 0;  ///< trimmed pairs at the returned transform
+  double inlier_share = 0.0;   ///< share of sample points with a model point within 0.1 m at the end
+  Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();  ///< (x, y, yaw) of T_model_sample, from the residual
+};
+
+/// Registers `sample` onto `model`, starting from `initial_guess`. Degenerate inputs
+/// (empty sets, fewer than 3 pairs) return valid = false with the initial guess.
+[[nodiscard]] TrimmedIcpResult register_trimmed_icp(const NearestNeighbors &model, const Points2 &sample,
+                                                    const Eigen::Isometry2d &initial_guess,
+                                                    const TrimmedIcpConfig &config = {});
+
+}  // namespace omnislam::slam

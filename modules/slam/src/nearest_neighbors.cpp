@@ -1,0 +1,96 @@
+#include "omnislam/slam/nearest_neighbors.hpp"
+
+#include <Eigen/Eigenvalues>
+#include <nanoflann.hpp>
+#include <utility>
+
+namespace omnislam::slam {
+
+// nanoflann reads the points through this adaptor; the tree keeps a reference to it, so
+// both live together behind the pointer and survive moves of NearestNeighbors.
+struct NearestNeighbors::Index {
+  struct Adaptor {
+    const Points2 *points;
+    [[nodiscard]] std::size_t kdtree_get_point_count() const { return points->size(); }
+    [[nodiscard]] double kdtree_get_pt(std::size_t i, std::size_t dim) const { return (*points)[i][dim]; }
+    template <class Box>
+    bool kdtree_get_bbox(Box &) const {
+      return false;
+    }
+  };
+  using Tree = nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<double, Adaptor>, Adaptor, 2,
+                                                   std::size_t>;
+
+  explicit Index(const Points2 *points) : adaptor{points}, tree(2, adaptor, {10}) { tree.buildIndex(); }
+  Adaptor adaptor;
+  Tree tree;
+};
+
+NearestNeighbors::NearestNeighbors(Points2 points) : points_(std::move(points)) {
+  if (!points_.empty()) index_ = std::make_unique<Index>(&points_);
+}
+
+NearestNeighbors::~NearestNeighbors() = default;
+
+// A moved std::vector keeps its buffer, so the tree's pointer to points_ must follow it.
+NearestNeighbors::NearestNeighbors(NearestNeighbors &&other) noexcept
+    : points_(std::move(other.points_)),
+      index_(std::move(other.index_)),
+      normals_(std::move(other.normals_)),
+      normals_ready_(other.normals_ready_) {
+  if (index_) index_->adaptor.points = &points_;
+}
+
+NearestNeighbors &NearestNeighbors::operator=(NearestNeighbors &&other) noexcept {
+  points_ = std::move(other.points_);
+  index_ = std::move(other.index_);
+  normals_ = std::move(other.normals_);
+  normals_ready_ = other.normals_ready_;
+  if (index_) index_->adaptor.points = &points_;
+  return *this;
+}
+
+std::optional<Neighbor> NearestNeighbors::nearest(const Point2 &query, double radius_m) const {
+  if (!index_) return std::nullopt;
+  std::size_t index = 0;
+  double distance_sq = 0.0;
+  nanoflann::KNNResultSet<double, std::size_t> result(1);
+  result.init(&index, &distance_sq);
+  index_->tree.findNeighbors(result, query.data(), nanoflann::SearchParams());
+  if (result.size() == 0 || distance_sq > radius_m * radius_m) return std::nullopt;
+  return Neighbor{index, distance_sq};
+}
+
+std::size_t NearestNeighbors::count_within(const Point2 &query, double radius_m) const {
+  if (!index_) return 0;
+  std::vector<std::pair<std::size_t, double>> found;
+  nanoflann::SearchParams params;
+  params.sorted = false;
+  return index_->tree.radiusSearch(query.data(), radius_m * radius_m, found, params);
+}
+
+const Points2 &NearestNeighbors::normals() const {
+  if (normals_ready_) return normals_;
+  constexpr double kNormalRadiusM = 0.15;
+  normals_.assign(points_.size(), Point2::Zero());
+  std::vector<std::pair<std::size_t, double>> found;
+  nanoflann::SearchParams params;
+  params.sorted = false;
+  for (std::size_t i = 0; i < points_.size(); ++i) {
+    index_->tree.radiusSearch(points_[i].data(), kNormalRadiusM * kNormalRadiusM, found, params);
+    if (found.size() < 3) continue;
+    Point2 mean = Point2::Zero();
+    for (const auto &[j, distance_sq] : found) mean += points_[j];
+    mean /= static_cast<double>(found.size());
+    Eigen::Matrix2d scatter = Eigen::Matrix2d::Zero();
+    for (const auto &[j, distance_sq] : found)
+      scatter += (points_[j] - mean) * (points_[j] - mean).transpose();
+    // Eigenvalues ascending: the first eigenvector is across the local line.
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> solver(scatter);
+    normals_[i] = solver.eigenvectors().col(0).normalized();
+  }
+  normals_ready_ = true;
+  return normals_;
+}
+
+}  // namespace omnislam::slam

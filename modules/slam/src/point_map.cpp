@@ -1,0 +1,49 @@
+#include "omnislam/slam/point_map.hpp"
+
+#include <algorithm>
+
+namespace omnislam::slam {
+
+void PointMap::integrate(const Points2 &points_map) {
+  ++integrations_;
+  // Fusion (thesis sec. 5.3): a point near an existing one becomes their hit-weighted mean.
+  std::vector<MapPoint> added;
+  for (const Point2 &p : points_map) {
+    if (const auto hit = index_.nearest(p, config_.fusion_radius_m)) {
+      MapPoint &target = points_[hit->index];
+      target.position_m = (target.position_m * target.hits + p) / (target.hits + 1);
+      ++target.hits;
+    } else {
+      added.push_back({p, 1, integrations_});
+    }
+  }
+  points_.insert(points_.end(), added.begin(), added.end());
+  rebuild_index();
+
+  // Noise filter: a point needs noise_min_neighbors others within noise_radius_m.
+  std::vector<MapPoint> kept;
+  kept.reserve(points_.size());
+  for (const MapPoint &point : points_) {
+    const std::size_t around = index_.count_within(point.position_m, config_.noise_radius_m);
+    if (around >= static_cast<std::size_t>(config_.noise_min_neighbors) + 1) kept.push_back(point);
+  }
+  // Every prune_every integrations, drop points seen fewer than prune_min_hits times.
+  if (config_.prune_every > 0 && integrations_ % config_.prune_every == 0) {
+    std::erase_if(kept, [&](const MapPoint &point) {
+      return point.hits < config_.prune_min_hits && integrations_ - point.first_seen >= config_.prune_min_age;
+    });
+  }
+  if (kept.size() != points_.size()) {
+    points_ = std::move(kept);
+    rebuild_index();
+  }
+}
+
+void PointMap::rebuild_index() {
+  Points2 positions;
+  positions.reserve(points_.size());
+  for (const MapPoint &point : points_) positions.push_back(point.position_m);
+  index_ = NearestNeighbors(std::move(positions));
+}
+
+}  // namespace omnislam::slam

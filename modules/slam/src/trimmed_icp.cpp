@@ -1,0 +1,198 @@
+#include "omnislam/slam/trimmed_icp.hpp"
+
+#include <Eigen/Cholesky>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <vector>
+
+namespace omnislam::slam {
+namespace {
+
+constexpr double kInlierDistanceM = 0.1;
+
+struct Pair {
+  Point2 model;
+  Point2 normal;  ///< model normal, zero when unknown (then the pair is point-to-point)
+  Point2 sample;  ///< original (untransformed) sample point
+  double residual_sq_m2;
+};
+
+struct Motion {
+  Eigen::Isometry2d T = Eigen::Isometry2d::Identity();
+  double scale = 1.0;
+  [[nodiscard]] Point2 apply(const Point2 &p) const { return T.linear() * (scale * p) + T.translation(); }
+};
+
+double residual_sq(const Point2 &moved, const Point2 &model, const Point2 &normal, IcpMetric metric) {
+  if (metric == IcpMetric::kPointToLine && !normal.isZero()) {
+    const double d = normal.dot(moved - model);
+    return d * d;
+  }
+  return (moved - model).squaredNorm();
+}
+
+// Steps 1-3 of Chetverikov 2002: pair every transformed sample point with its nearest
+// model point inside dmax, sort by residual and keep the best overlap * N_p.
+std::vector<Pair> trimmed_pairs(const NearestNeighbors &model, const Points2 &sample, const Motion &motion,
+                                double search_radius_m, const TrimmedIcpConfig &config) {
+  const Points2 *normals = config.metric == IcpMetric::kPointToLine ? &model.normals() : nullptr;
+  std::vector<Pair> pairs;
+  pairs.reserve(sample.size());
+  for (const Point2 &p : sample) {
+    const Point2 moved = motion.apply(p);
+    if (const auto hit = model.nearest(moved, search_radius_m)) {
+      const Point2 &m = model.points()[hit->index];
+      const Point2 normal = normals ? (*normals)[hit->index] : Point2::Zero();
+      pairs.push_back({m, normal, p, residual_sq(moved, m, normal, config.metric)});
+    }
+  }
+  const auto keep = std::min(pairs.size(), static_cast<std::size_t>(config.overlap * sample.size()));
+  std::nth_element(pairs.begin(), pairs.begin() + static_cast<std::ptrdiff_t>(keep), pairs.end(),
+                   [](const Pair &a, const Pair &b) { return a.residual_sq_m2 < b.residual_sq_m2; });
+  pairs.resize(keep);
+  return pairs;
+}
+
+// Step 5 (thesis sec. 5.1, Horn 1987, planar case): centre both sets, rotation from
+// C = sum m'.p' and S = sum m' x p', optional scale, translation m_mean - s R p_mean.
+Motion horn_motion(const std::vector<Pair> &pairs, bool estimate_scale) {
+  Point2 model_mean = Point2::Zero(), sample_mean = Point2::Zero();
+  for (const Pair &pair : pairs) {
+    model_mean += pair.model;
+    sample_mean += pair.sample;
+  }
+  model_mean /= static_cast<double>(pairs.size());
+  sample_mean /= static_cast<double>(pairs.size());
+  double c = 0.0, s = 0.0, sample_norm_sq = 0.0;
+  for (const Pair &pair : pairs) {
+    const Point2 m = pair.model - model_mean, p = pair.sample - sample_mean;
+    c += m.dot(p);
+    s += p.x() * m.y() - p.y() * m.x();
+    sample_norm_sq += p.squaredNorm();
+  }
+  Motion motion;
+  const Eigen::Rotation2Dd rotation(std::atan2(s, c));
+  if (estimate_scale && sample_norm_sq > 0.0) motion.scale = std::hypot(c, s) / sample_norm_sq;
+  motion.T.linear() = rotation.toRotationMatrix();
+  motion.T.translation() = model_mean - motion.scale * (rotation * sample_mean);
+  return motion;
+}
+
+// Normal equations of the residuals w.r.t. a small motion (dx, dy, dyaw) applied on the
+// left of the current transform: point-to-line rows n^T [I | perp(p')], else both rows.
+struct NormalEquations {
+  Eigen::Matrix3d JtJ = Eigen::Matrix3d::Zero();
+  Eigen::Vector3d Jtr = Eigen::Vector3d::Zero();
+};
+
+NormalEquations normal_equations(const std::vector<Pair> &pairs, const Motion &motion) {
+  NormalEquations eq;
+  for (const Pair &pair : pairs) {
+    const Point2 moved = motion.apply(pair.sample);
+    Eigen::Matrix<double, 2, 3> J;
+    J << 1.0, 0.0, -moved.y(), 0.0, 1.0, moved.x();
+    if (!pair.normal.isZero()) {
+      const Eigen::RowVector3d row = pair.normal.transpose() * J;
+      eq.JtJ += row.transpose() * row;
+      eq.Jtr += row.transpose() * pair.normal.dot(moved - pair.model);
+    } else {
+      eq.JtJ += J.transpose() * J;
+      eq.Jtr += J.transpose() * (moved - pair.model);
+    }
+  }
+  return eq;
+}
+
+Motion point_to_line_motion(const std::vector<Pair> &pairs, const Motion &current) {
+  const NormalEquations eq = normal_equations(pairs, current);
+  const Eigen::Vector3d delta = eq.JtJ.ldlt().solve(-eq.Jtr);
+  if (!delta.allFinite()) return current;
+  Eigen::Isometry2d step = Eigen::Isometry2d::Identity();
+  step.linear() = Eigen::Rotation2Dd(delta.z()).toRotationMatrix();
+  step.translation() = delta.head<2>();
+  return {step * current.T, 1.0};
+}
+
+double mean_sq(const std::vector<Pair> &pairs) {
+  double sum = 0.0;
+  for (const Pair &pair : pairs) sum += pair.residual_sq_m2;
+  return pairs.empty() ? 0.0 : sum / static_cast<double>(pairs.size());
+}
+
+// Covariance of (x, y, yaw): sigma^2 (J^T J)^-1 with sigma^2 the residual variance.
+Eigen::Matrix3d covariance_of(const std::vector<Pair> &pairs, const Motion &motion, double error_m2) {
+  const NormalEquations eq = normal_equations(pairs, motion);
+  if (std::abs(eq.JtJ.determinant()) < 1e-12) return Eigen::Matrix3d::Identity() * 1e6;
+  return std::max(error_m2, 1e-8) * eq.JtJ.inverse();
+}
+
+}  // namespace
+
+TrimmedIcpResult register_trimmed_icp(const NearestNeighbors &model, const Points2 &sample,
+                                      const Eigen::Isometry2d &initial_guess,
+                                      const TrimmedIcpConfig &config) {
+  TrimmedIcpResult result;
+  result.T_model_sample = initial_guess;
+  result.sample_points = sample.size();
+  if (model.empty() || sample.size() < 3) return result;
+
+  Motion current{initial_guess, 1.0};
+  Motion evaluated = current;  // the motion at which the last error was measured
+  Motion best = current;
+  double best_error = std::numeric_limits<double>::infinity();
+  double previous_error = std::numeric_limits<double>::infinity();
+  double search_radius = config.initial_search_radius_m;
+  std::vector<Pair> pairs, best_pairs;
+
+  for (int iteration = 0; iteration < config.max_iterations; ++iteration) {
+    pairs = trimmed_pairs(model, sample, current, search_radius, config);
+    if (pairs.size() < 3) break;
+    evaluated = current;
+    const double error = mean_sq(pairs);
+    if (iteration == 0) result.first_error_m2 = error;
+    result.iterations = iteration + 1;
+    result.final_error_m2 = error;
+    if (error < best_error) {
+      best_error = error;
+      best = current;
+      best_pairs = pairs;
+    }
+    if (error <= config.target_error_m2 ||
+        (iteration > 0 && std::abs(previous_error - error) <= config.min_relative_change * previous_error)) {
+      result.converged = true;
+      break;
+    }
+    previous_error = error;
+    // dmax shrinks to the largest distance kept in this iteration (thesis sec. 5.1 step 1).
+    double largest_sq = 0.0;
+    for (const Pair &pair : pairs)
+      largest_sq = std::max(largest_sq, (current.apply(pair.sample) - pair.model).squaredNorm());
+    search_radius = std::max(config.min_search_radius_m, std::sqrt(largest_sq));
+    current = config.metric == IcpMetric::kPointToLine ? point_to_line_motion(pairs, current)
+                                                       : horn_motion(pairs, config.estimate_scale);
+  }
+  if (best_pairs.empty()) return result;
+
+  // The thesis keeps the global minimum and returns it when the last e is > 10% above it.
+  Motion returned = evaluated;
+  if (config.keep_global_minimum && result.final_error_m2 > 1.1 * best_error) {
+    returned = best;
+    pairs = best_pairs;
+    result.final_error_m2 = best_error;
+  }
+  result.valid = true;
+  result.T_model_sample = returned.T;
+  result.scale = returned.scale;
+  result.kept_pairs = pairs.size();
+  result.srel_percent = result.first_error_m2 > 0.0
+                            ? 100.0 * (result.first_error_m2 - result.final_error_m2) / result.first_error_m2
+                            : 0.0;
+  std::size_t inliers = 0;
+  for (const Point2 &p : sample) inliers += model.nearest(returned.apply(p), kInlierDistanceM) ? 1 : 0;
+  result.inlier_share = static_cast<double>(inliers) / static_cast<double>(sample.size());
+  result.covariance = covariance_of(pairs, returned, result.final_error_m2);
+  return result;
+}
+
+}  // namespace omnislam::slam

@@ -1,0 +1,95 @@
+#pragma once
+
+#include <Eigen/Geometry>
+#include <cmath>
+#include <numbers>
+#include <optional>
+#include <random>
+#include <vector>
+
+#include "omnislam/slam/nearest_neighbors.hpp"
+
+// A synthetic world for SLAM tests: wall segments, scans by ray casting one beam per degree
+// with range noise, and the thesis odometry noise model.
+namespace omnislam::test {
+
+struct Segment {
+  Eigen::Vector2d a, b;
+};
+
+/// An L-shaped room with two boxes, about 7 x 5 m.
+inline std::vector<Segment> l_room() {
+  const std::vector<Eigen::Vector2d> outline = {{-1, -1}, {6, -1}, {6, 1.5}, {2.5, 1.5}, {2.5, 4}, {-1, 4}};
+  std::vector<Segment> walls;
+  for (std::size_t i = 0; i < outline.size(); ++i)
+    walls.push_back({outline[i], outline[(i + 1) % outline.size()]});
+  auto box = [&](double x0, double y0, double x1, double y1) {
+    walls.push_back({{x0, y0}, {x1, y0}});
+    walls.push_back({{x1, y0}, {x1, y1}});
+    walls.push_back({{x1, y1}, {x0, y1}});
+    walls.push_back({{x0, y1}, {x0, y0}});
+  };
+  box(3.5, 0.4, 4.1, 0.9);
+  box(0.2, 2.8, 0.8, 3.3);
+  return walls;
+}
+
+/// Distance along the ray from `origin` in direction `angle` to the nearest segment.
+inline std::optional<double> cast(const std::vector<Segment> &walls, const Eigen::Vector2d &origin,
+                                  double angle) {
+  const Eigen::Vector2d d(std::cos(angle), std::sin(angle));
+  std::optional<double> best;
+  for (const Segment &s : walls) {
+    const Eigen::Vector2d e = s.b - s.a;
+    const double denom = d.x() * e.y() - d.y() * e.x();
+    if (std::abs(denom) < 1e-12) continue;
+    const Eigen::Vector2d w = s.a - origin;
+    const double t = (w.x() * e.y() - w.y() * e.x()) / denom;
+    const double u = (w.x() * d.y() - w.y() * d.x()) / denom;
+    if (t > 0 && u >= 0 && u <= 1 && (!best || t < *best)) best = t;
+  }
+  return best;
+}
+
+/// A scan in base_link: one point per degree within [min, max] range, Gaussian range noise.
+inline slam::Points2 scan_from(const std::vector<Segment> &walls, const Eigen::Isometry2d &T_map_base,
+                               std::mt19937_64 &rng, double noise_m = 0.01, double max_range_m = 3.0) {
+  std::normal_distribution<double> noise(0.0, noise_m);
+  const double yaw = std::atan2(T_map_base.linear()(1, 0), T_map_base.linear()(0, 0));
+  slam::Points2 scan;
+  for (int deg = 0; deg < 360; ++deg) {
+    const double azimuth = (deg + 0.5) * std::numbers::pi / 180.0;
+    const auto range = cast(walls, T_map_base.translation(), yaw + azimuth);
+    if (!range || *range > max_range_m || *range < 0.3) continue;
+    const double r = *range + noise(rng);
+    scan.emplace_back(r * std::cos(azimuth), r * std::sin(azimuth));
+  }
+  return scan;
+}
+
+inline Eigen::Isometry2d pose(double x, double y, double yaw) {
+  Eigen::Isometry2d T = Eigen::Isometry2d::Identity();
+  T.linear() = Eigen::Rotation2Dd(yaw).toRotationMatrix();
+  T.translation() = Eigen::Vector2d(x, y);
+  return T;
+}
+
+/// Thesis noise model (architecture.md): length x (1 + U(-0.1, 0.1)), yaw error the larger of
+/// U(-0.1, 0.1) x step yaw and U(-1.5, 1.5) deg, composed step by step.
+inline std::vector<Eigen::Isometry2d> noisy_odometry(const std::vector<Eigen::Isometry2d> &truth,
+                                                     std::mt19937_64 &rng) {
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  std::vector<Eigen::Isometry2d> odometry{truth.front()};
+  for (std::size_t i = 1; i < truth.size(); ++i) {
+    const Eigen::Isometry2d step = truth[i - 1].inverse() * truth[i];
+    const double step_yaw = std::atan2(step.linear()(1, 0), step.linear()(0, 0));
+    const double relative = 0.1 * u(rng) * step_yaw;
+    const double absolute = 1.5 * std::numbers::pi / 180.0 * u(rng);
+    const double yaw_error = std::abs(relative) > std::abs(absolute) ? relative : absolute;
+    const Eigen::Vector2d t = step.translation() * (1.0 + 0.1 * u(rng));
+    odometry.push_back(odometry.back() * pose(t.x(), t.y(), step_yaw + yaw_error));
+  }
+  return odometry;
+}
+
+}  // namespace omnislam::test

@@ -1,0 +1,95 @@
+#include <catch2/catch.hpp>
+#include <cmath>
+#include <random>
+
+#include "omnislam/slam/trimmed_icp.hpp"
+#include "synthetic_room.hpp"
+
+using omnislam::slam::NearestNeighbors;
+using omnislam::slam::Points2;
+using omnislam::slam::register_trimmed_icp;
+using omnislam::test::pose;
+
+namespace {
+
+double yaw_of(const Eigen::Isometry2d &T) { return std::atan2(T.linear()(1, 0), T.linear()(0, 0)); }
+
+}  // namespace
+
+TEST_CASE("trimmed ICP recovers a known motion between two scans of a room", "[slam][icp]") {
+  const auto walls = omnislam::test::l_room();
+  std::mt19937_64 rng(7);
+  const Eigen::Isometry2d T_map_a = pose(1.0, 0.5, 0.0);
+  const Eigen::Isometry2d T_map_b = pose(1.25, 0.7, 0.06);
+  const Points2 scan_a = omnislam::test::scan_from(walls, T_map_a, rng);
+  const Points2 scan_b = omnislam::test::scan_from(walls, T_map_b, rng);
+  const NearestNeighbors model(scan_a);
+  const Eigen::Isometry2d truth = T_map_a.inverse() * T_map_b;  // T_a_b
+  // Start 8 cm and 3 deg off, like a noisy odometry step.
+  const Eigen::Isometry2d guess = truth * pose(0.06, -0.05, 0.05);
+  const auto result = register_trimmed_icp(model, scan_b, guess);
+  INFO("iterations " << result.iterations << " srel " << result.srel_percent << " rms "
+                     << std::sqrt(result.final_error_m2) << " inliers " << result.inlier_share);
+  REQUIRE(result.valid);
+  const Eigen::Isometry2d error = truth.inverse() * result.T_model_sample;
+  CHECK(error.translation().norm() < 0.01);
+  CHECK(std::abs(yaw_of(error)) < 0.2 * std::numbers::pi / 180.0);
+  CHECK(std::sqrt(result.final_error_m2) < 0.02);
+  CHECK(result.srel_percent > 50.0);
+  CHECK(result.inlier_share > 0.8);
+  CHECK(result.iterations <= 30);
+  // The covariance is a small positive-definite matrix.
+  CHECK(result.covariance.determinant() > 0.0);
+  CHECK(result.covariance(0, 0) < 1e-4);
+}
+
+TEST_CASE("trimmed ICP: trimming ignores points the model does not contain", "[slam][icp]") {
+  const auto walls = omnislam::test::l_room();
+  std::mt19937_64 rng(11);
+  const Points2 scan = omnislam::test::scan_from(walls, pose(1.0, 1.0, 0.0), rng, 0.005);
+  Points2 sample;
+  const Eigen::Isometry2d truth = pose(0.1, -0.05, 0.03);
+  for (const auto &p : scan) sample.push_back(truth.inverse() * p);
+  // 25% outliers: a clutter object only the sample sees.
+  std::uniform_real_distribution<double> clutter(0.0, 0.6);
+  for (std::size_t i = 0; i < scan.size() / 4; ++i)
+    sample.emplace_back(2.0 + clutter(rng), -0.5 + clutter(rng));
+  const auto result = register_trimmed_icp(NearestNeighbors(scan), sample, Eigen::Isometry2d::Identity());
+  INFO("iterations " << result.iterations << " converged " << result.converged << " srel "
+                     << result.srel_percent << " rms " << std::sqrt(result.final_error_m2));
+  REQUIRE(result.valid);
+  const Eigen::Isometry2d error = truth.inverse() * result.T_model_sample;
+  CHECK(error.translation().norm() < 0.005);
+  CHECK(std::abs(yaw_of(error)) < 0.002);
+}
+
+TEST_CASE("trimmed ICP: thesis scale mode estimates a scale factor", "[slam][icp]") {
+  const auto walls = omnislam::test::l_room();
+  std::mt19937_64 rng(3);
+  const Points2 model = omnislam::test::scan_from(walls, pose(1.0, 1.0, 0.0), rng, 0.0);
+  Points2 sample;
+  for (const auto &p : model) sample.push_back(p / 1.03);  // the sample is 3% short
+  omnislam::slam::TrimmedIcpConfig config;
+  config.metric = omnislam::slam::IcpMetric::kPointToPoint;
+  config.estimate_scale = true;
+  config.overlap = 0.95;
+  const auto result =
+      register_trimmed_icp(NearestNeighbors(model), sample, Eigen::Isometry2d::Identity(), config);
+  REQUIRE(result.valid);
+  CHECK(result.scale == Approx(1.03).margin(0.005));
+}
+
+TEST_CASE("trimmed ICP: degenerate inputs are reported invalid", "[slam][icp]") {
+  const Points2 few = {{1.0, 0.0}, {0.0, 1.0}};
+  const Eigen::Isometry2d guess = pose(0.3, 0.2, 0.1);
+  auto result = register_trimmed_icp(NearestNeighbors(Points2{}), few, guess);
+  CHECK_FALSE(result.valid);
+  CHECK(result.T_model_sample.isApprox(guess));
+  result = register_trimmed_icp(NearestNeighbors(few), few, guess);
+  CHECK_FALSE(result.valid);
+  // Sets too far apart for the search radius never pair up.
+  const Points2 far = {{10, 10}, {11, 10}, {10, 11}, {11, 11}};
+  const Points2 near = {{0, 0}, {1, 0}, {0, 1}, {1, 1}};
+  result = register_trimmed_icp(NearestNeighbors(far), near, Eigen::Isometry2d::Identity());
+  CHECK_FALSE(result.valid);
+}
