@@ -74,22 +74,4 @@ inline Eigen::Isometry2d pose(double x, double y, double yaw) {
   return T;
 }
 
-/// Thesis noise model (architecture.md): length x (1 + U(-0.1, 0.1)), yaw error the larger of
-/// U(-0.1, 0.1) x step yaw and U(-1.5, 1.5) deg, composed step by step.
-inline std::vector<Eigen::Isometry2d> noisy_odometry(const std::vector<Eigen::Isometry2d> &truth,
-                                                     std::mt19937_64 &rng) {
-  std::uniform_real_distribution<double> u(-1.0, 1.0);
-  std::vector<Eigen::Isometry2d> odometry{truth.front()};
-  for (std::size_t i = 1; i < truth.size(); ++i) {
-    const Eigen::Isometry2d step = truth[i - 1].inverse() * truth[i];
-    const double step_yaw = std::atan2(step.linear()(1, 0), step.linear()(0, 0));
-    const double relative = 0.1 * u(rng) * step_yaw;
-    const double absolute = 1.5 * std::numbers::pi / 180.0 * u(rng);
-    const double yaw_error = std::abs(relative) > std::abs(absolute) ? relative : absolute;
-    const Eigen::Vector2d t = step.translation() * (1.0 + 0.1 * u(rng));
-    odometry.push_back(odometry.back() * pose(t.x(), t.y(), step_yaw + yaw_error));
-  }
-  return odometry;
-}
-
 }  // namespace omnislam::test
