@@ -2,12 +2,18 @@
 #include <cstdio>
 #include <exception>
 
+#include "evaluate_command.hpp"
 #include "mirror_lut_command.hpp"
+#include "replay_command.hpp"
+#include "scan_command.hpp"
 
 int main(int argc, char **argv) {
   CLI::App app{"omnislam: omnidirectional stereo SLAM tools"};
   app.require_subcommand(1);
   omnislam::app::add_mirror_lut_command(app);
+  omnislam::app::add_scan_command(app);
+  omnislam::app::add_replay_command(app);
+  omnislam::app::add_evaluate_command(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError &error) {

@@ -1,0 +1,10 @@
+#pragma once
+
+#include <CLI/CLI.hpp>
+
+namespace omnislam::app {
+
+/// Registers `omnislam replay DATASET [--config FILE] --out DIR [--odometry-noise thesis --seed N]`.
+void add_replay_command(CLI::App &app);
+
+}  // namespace omnislam::app

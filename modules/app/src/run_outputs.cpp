@@ -1,0 +1,174 @@
+#include "run_outputs.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <nlohmann/json.hpp>
+#include <numbers>
+#include <sstream>
+#include <string>
+
+#include "omnislam/io/run_files.hpp"
+#include "omnislam/slam/evaluation.hpp"
+#include "poses.hpp"
+
+namespace omnislam::app {
+namespace {
+
+constexpr double kMmPerM = 1000.0;
+constexpr double kDegPerRad = 180.0 / std::numbers::pi;
+
+double yaw_of(const Eigen::Isometry2d &T) { return std::atan2(T.linear()(1, 0), T.linear()(0, 0)); }
+
+nlohmann::json stage_statistics(const std::vector<FrameRecord> &frames) {
+  nlohmann::json stages = nlohmann::json::object();
+  for (std::size_t s = 0; s < kStages.size(); ++s) {
+    std::vector<double> ms;
+    for (const FrameRecord &f : frames) ms.push_back(f.stage_ms[s]);
+    std::sort(ms.begin(), ms.end());
+    double mean = 0.0;
+    for (double v : ms) mean += v;
+    mean = ms.empty() ? 0.0 : mean / static_cast<double>(ms.size());
+    auto at = [&](double q) { return ms.empty() ? 0.0 : ms[static_cast<std::size_t>(q * (ms.size() - 1))]; };
+    stages[std::string(kStages[s])] = {{"mean", mean}, {"p50", at(0.5)}, {"p99", at(0.99)}};
+  }
+  return stages;
+}
+
+nlohmann::json errors_json(const slam::TrajectoryError &e) {
+  return {{"rmse_m", e.rmse_m}, {"max_m", e.max_m}, {"final_m", e.final_m}, {"max_frame", e.max_frame + 1}};
+}
+
+std::string thesis_localisation(const RunRecord &run) {
+  std::ostringstream out;
+  char line[128];
+  for (const FrameRecord &f : run.frames) {
+    if (f.integrated) {
+      std::snprintf(line, sizeof line, "%.3f %.3f %.4f\n", f.T_map_base.translation().x() * kMmPerM,
+                    f.T_map_base.translation().y() * kMmPerM, yaw_of(f.T_map_base) * kDegPerRad);
+    } else {
+      std::snprintf(line, sizeof line, "0 0 0\n");
+    }
+    out << line;
+  }
+  return out.str();
+}
+
+std::string thesis_vectors(const RunRecord &run) {
+  std::ostringstream out;
+  out << "# image attempt srel_percent mean_srel_percent iterations\n";
+  double srel_sum = 0.0;
+  int accepted = 0;
+  char line[128];
+  for (std::size_t i = 0; i < run.frames.size(); ++i) {
+    const FrameRecord &f = run.frames[i];
+    if (f.integrated) {
+      srel_sum += f.srel_percent;
+      ++accepted;
+    }
+    std::snprintf(line, sizeof line, "%zu %d %.3f %.3f %d\n", i + 1, static_cast<int>(f.attempt),
+                  f.srel_percent, accepted ? srel_sum / accepted : 0.0, f.iterations);
+    out << line;
+  }
+  return out.str();
+}
+
+std::string thesis_odometry(const RunRecord &run) {
+  std::ostringstream out;
+  char line[96];
+  for (const Eigen::Isometry2d &T : run.odometry_map) {
+    std::snprintf(line, sizeof line, "%.3f %.3f\n", T.translation().x() * kMmPerM,
+                  T.translation().y() * kMmPerM);
+    out << line;
+  }
+  return out.str();
+}
+
+std::string profile_csv(const RunRecord &run, bool thesis_timelog) {
+  std::ostringstream out;
+  out << (thesis_timelog ? "# image" : "frame");
+  for (std::string_view stage : kStages)
+    out << (thesis_timelog ? " " : ",") << stage << (thesis_timelog ? "" : "_ms");
+  out << '\n';
+  char value[32];
+  for (std::size_t i = 0; i < run.frames.size(); ++i) {
+    out << i + 1;
+    for (double ms : run.frames[i].stage_ms) {
+      std::snprintf(value, sizeof value, "%s%.4f", thesis_timelog ? " " : ",", ms);
+      out << value;
+    }
+    out << '\n';
+  }
+  return out.str();
+}
+
+std::vector<io::MapPointRecord> map_records(const slam::PointMap &map) {
+  std::vector<io::MapPointRecord> records;
+  records.reserve(map.points().size());
+  for (const slam::MapPoint &p : map.points())
+    records.push_back({p.position_m.x(), p.position_m.y(), p.hits});
+  return records;
+}
+
+}  // namespace
+
+OutputWriter::OutputWriter(std::filesystem::path dir) : dir_(std::move(dir)) {
+  std::error_code error;
+  std::filesystem::create_directories(dir_, error);
+  if (error) throw std::runtime_error("cannot create " + dir_.string() + ": " + error.message());
+}
+
+void OutputWriter::write_thesis_map(int frame, const slam::PointMap &map) const {
+  std::ostringstream out;
+  char line[96];
+  for (const slam::MapPoint &p : map.points()) {
+    std::snprintf(line, sizeof line, "%.3f %.3f %d\n", p.position_m.x() * kMmPerM, p.position_m.y() * kMmPerM,
+                  p.hits);
+    out << line;
+  }
+  io::write_text_file(dir_ / ("mapa" + std::to_string(frame) + ".txt"), out.str());
+}
+
+void OutputWriter::write_all(const RunRecord &run, const slam::PointMap &map,
+                             const io::DatasetInfo &info) const {
+  std::vector<io::StampedPose> trajectory;
+  std::vector<Eigen::Isometry2d> estimate;
+  for (const FrameRecord &f : run.frames) {
+    trajectory.push_back(to_stamped(f.t_s, f.T_map_base));
+    estimate.push_back(f.T_map_base);
+  }
+  io::write_tum_file(dir_ / "trajectory.tum", trajectory);
+  const auto records = map_records(map);
+  io::write_map_csv(dir_ / "map.csv", records);
+  io::write_map_ply(dir_ / "map.ply", records);
+  io::write_text_file(dir_ / "profile.csv", profile_csv(run, false));
+  io::write_text_file(dir_ / "timelog.txt", profile_csv(run, true));
+  io::write_text_file(dir_ / "autolocalizacao.txt", thesis_localisation(run));
+  io::write_text_file(dir_ / "vetores.txt", thesis_vectors(run));
+  io::write_text_file(dir_ / "odometriaxy.txt", thesis_odometry(run));
+
+  nlohmann::json summary;
+  summary["dataset"] = info.name;
+  summary["frames"] = run.frames.size();
+  const auto integrated =
+      std::count_if(run.frames.begin(), run.frames.end(), [](auto &f) { return f.integrated; });
+  summary["integrated"] = integrated;
+  summary["not_integrated"] = static_cast<long>(run.frames.size()) - integrated;
+  summary["skipped"] = std::count_if(run.frames.begin(), run.frames.end(), [](auto &f) { return f.skipped; });
+  summary["map_points"] = map.points().size();
+  summary["stage_ms"] = stage_statistics(run.frames);
+  if (run.ground_truth.size() == estimate.size() && !estimate.empty()) {
+    const auto slam_error = slam::trajectory_error(estimate, run.ground_truth);
+    const auto odometry_error = slam::trajectory_error(run.odometry_map, run.ground_truth);
+    summary["ate"] = errors_json(slam_error);
+    summary["odometry_ate"] = errors_json(odometry_error);
+    std::printf(
+        "%s: %zu frames, %ld integrated; position error max %.1f mm, final %.1f mm, rmse %.1f mm "
+        "(odometry alone: max %.1f mm)\n",
+        info.name.c_str(), run.frames.size(), static_cast<long>(integrated), slam_error.max_m * kMmPerM,
+        slam_error.final_m * kMmPerM, slam_error.rmse_m * kMmPerM, odometry_error.max_m * kMmPerM);
+  }
+  io::write_text_file(dir_ / "summary.json", summary.dump(2) + "\n");
+}
+
+}  // namespace omnislam::app

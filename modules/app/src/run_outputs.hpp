@@ -1,0 +1,28 @@
+#pragma once
+
+#include <filesystem>
+
+#include "omnislam/io/dataset.hpp"
+#include "omnislam/slam/point_map.hpp"
+#include "run_record.hpp"
+
+// Writes a run's output directory (architecture.md `omnislam replay`): trajectory.tum,
+// map.csv, map.ply, profile.csv, summary.json and the thesis's files.
+namespace omnislam::app {
+
+class OutputWriter {
+ public:
+  /// Creates the directory; throws std::runtime_error naming it if that fails.
+  explicit OutputWriter(std::filesystem::path dir);
+
+  /// mapaN.txt: the global map after image N (thesis format: x y count, millimetres).
+  void write_thesis_map(int frame, const slam::PointMap &map) const;
+
+  /// Everything else, once the run is over.
+  void write_all(const RunRecord &run, const slam::PointMap &map, const io::DatasetInfo &info) const;
+
+ private:
+  std::filesystem::path dir_;
+};
+
+}  // namespace omnislam::app

@@ -1,0 +1,58 @@
+#include "scan_command.hpp"
+
+#include <cstdio>
+#include <memory>
+#include <numbers>
+#include <string>
+
+#include "omnislam/io/config.hpp"
+#include "omnislam/io/image_file.hpp"
+#include "omnislam/stereo/scan_reconstructor.hpp"
+
+namespace omnislam::app {
+namespace {
+
+constexpr double kDegPerRad = 180.0 / std::numbers::pi;
+
+struct ScanOptions {
+  std::string image;
+  std::string config;
+  bool quiet = false;
+};
+
+void print_csv(const stereo::LocalScan &scan) {
+  std::printf("azimuth_deg,range_m,x_m,y_m,z_m,inner_row,outer_row\n");
+  for (const stereo::ScanPoint &p : scan.points) {
+    std::printf("%.3f,%.4f,%.4f,%.4f,%.4f,%.3f,%.3f\n", p.azimuth_rad * kDegPerRad, p.range_m, p.x_m, p.y_m,
+                p.z_m, static_cast<double>(p.inner_row), static_cast<double>(p.outer_row));
+  }
+}
+
+void print_summary(const std::string &image, const stereo::LocalScan &scan) {
+  const stereo::ScanStats &s = scan.stats;
+  std::fprintf(stderr,
+               "%s: candidates inner %d / outer %d, admissible pairs %d, matched %d, "
+               "no intersection %d, outside cut-offs %d, filtered %d, points %d\n",
+               image.c_str(), s.inner.candidates, s.outer.candidates, s.admissible_pairs, s.matched,
+               s.no_intersection, s.outside_cutoffs, s.filtered_out, s.points);
+}
+
+}  // namespace
+
+void add_scan_command(CLI::App &app) {
+  auto *command = app.add_subcommand("scan", "print the local scan of one omnidirectional image as CSV");
+  auto options = std::make_shared<ScanOptions>();
+  command->add_option("IMAGE", options->image, "8-bit image of the configured camera size")->required();
+  command->add_option("--config", options->config, "YAML configuration (camera, vision, stereo)");
+  command->add_flag("--quiet", options->quiet, "no summary on stderr");
+  command->callback([options] {
+    const io::Config config = options->config.empty() ? io::Config{} : io::load_config(options->config);
+    const cv::Mat image = io::read_camera_image(options->image, config.scan.camera);
+    stereo::ScanReconstructor reconstructor(config.scan);
+    const stereo::LocalScan scan = reconstructor.reconstruct(image);
+    print_csv(scan);
+    if (!options->quiet) print_summary(options->image, scan);
+  });
+}
+
+}  // namespace omnislam::app

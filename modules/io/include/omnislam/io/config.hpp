@@ -1,0 +1,37 @@
+#pragma once
+
+#include <filesystem>
+
+#include "omnislam/slam/slam.hpp"
+#include "omnislam/stereo/stereo_config.hpp"
+
+/// @file
+/// The YAML configuration of the omnislam commands. Every key is optional (the defaults
+/// are the thesis camera and settings); an unknown key or a value of the wrong type is an
+/// error naming the key and file:line. Sections and keys:
+///
+/// ```yaml
+/// camera:   {width, height, center_px: [u, v], focal_mm, pixel_pitch_mm,
+///            azimuth_offset_deg, camera_height_m}
+/// vision:   {sigma_px, half_window_px, auto_thresholds, high_threshold, low_threshold,
+///            auto_not_edge_fraction, auto_low_ratio, auto_min_high_threshold,
+///            min_fragment_px, horizontal_ratio, max_edges_per_column, blackman_smoothing,
+///            min_relative_contrast, half_window_rows, half_window_columns}
+/// stereo:   {min_range_m, max_range_m, disparity_margin_px, occlusion_cost,
+///            subpixel: none | edge_peak | cost_curve, triangulation: exact | table,
+///            near_cutoff_m, far_cutoff_m, one_point_per_degree}
+/// ```
+/// The field meanings are documented on the structs (vision_config.hpp, stereo_config.hpp).
+
+namespace omnislam::io {
+
+struct Config {
+  stereo::ScanConfig scan;
+  slam::SlamConfig slam;
+};
+
+/// Reads a configuration file on top of the defaults. Throws std::runtime_error naming
+/// the file (and file:line:column of the offending key) on any problem.
+[[nodiscard]] Config load_config(const std::filesystem::path &file);
+
+}  // namespace omnislam::io

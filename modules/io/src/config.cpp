@@ -1,0 +1,132 @@
+#include "omnislam/io/config.hpp"
+
+#include <string>
+
+#include "camera_fields.hpp"
+#include "yaml_fields.hpp"
+
+namespace omnislam::io {
+namespace detail {
+
+void read_camera_fields(YamlSection &section, mirror::MirrorConfig &camera) {
+  section.read("width", camera.image_width_px);
+  section.read("height", camera.image_height_px);
+  if (section.has("center_px")) {
+    const YAML::Node center = section.node("center_px");
+    if (!center.IsSequence() || center.size() != 2) section.fail("center_px", "must be [u, v] in pixels");
+    try {
+      camera.center_u_px = center[0].as<double>();
+      camera.center_v_px = center[1].as<double>();
+    } catch (const YAML::Exception &) {
+      section.fail("center_px", "must be [u, v] in pixels");
+    }
+  }
+  section.read("focal_mm", camera.focal_mm);
+  section.read("pixel_pitch_mm", camera.pixel_pitch_mm);
+  section.read("azimuth_offset_deg", camera.azimuth_offset_deg);
+  if (camera.image_width_px <= 0) section.fail("width", "must be positive");
+  if (camera.image_height_px <= 0) section.fail("height", "must be positive");
+  if (!(camera.focal_mm > 0.0)) section.fail("focal_mm", "must be positive");
+  if (!(camera.pixel_pitch_mm > 0.0)) section.fail("pixel_pitch_mm", "must be positive");
+}
+
+}  // namespace detail
+namespace {
+
+using detail::YamlSection;
+
+void read_vision(YamlSection &section, vision::VisionConfig &vision) {
+  vision::CannyConfig &canny = vision.canny;
+  section.read("sigma_px", canny.sigma_px);
+  section.read("half_window_px", canny.half_window_px);
+  section.read("auto_thresholds", canny.auto_thresholds);
+  section.read("high_threshold", canny.high_threshold);
+  section.read("low_threshold", canny.low_threshold);
+  section.read("auto_not_edge_fraction", canny.auto_not_edge_fraction);
+  section.read("auto_low_ratio", canny.auto_low_ratio);
+  section.read("auto_min_high_threshold", canny.auto_min_high_threshold);
+  section.read("min_fragment_px", canny.min_fragment_px);
+  vision::EdgeSelectionConfig &selection = vision.selection;
+  section.read("horizontal_ratio", selection.horizontal_ratio);
+  section.read("max_edges_per_column", selection.max_edges_per_column);
+  section.read("blackman_smoothing", selection.blackman_smoothing);
+  section.read("min_relative_contrast", selection.min_relative_contrast);
+  section.read("half_window_rows", selection.half_window_rows);
+  section.read("half_window_columns", selection.half_window_columns);
+  if (canny.sigma_px < 0.0) section.fail("sigma_px", "must be >= 0");
+  if (selection.max_edges_per_column < 1 || selection.max_edges_per_column > 16) {
+    section.fail("max_edges_per_column", "must be in 1..16");
+  }
+  if (selection.half_window_rows < 0 || selection.half_window_rows > 20) {
+    section.fail("half_window_rows", "must be in 0..20");
+  }
+  if (selection.half_window_columns < 0 || selection.half_window_columns > 20) {
+    section.fail("half_window_columns", "must be in 0..20");
+  }
+}
+
+void read_stereo(YamlSection &section, stereo::StereoConfig &stereo) {
+  section.read("min_range_m", stereo.min_range_m);
+  section.read("max_range_m", stereo.max_range_m);
+  section.read("disparity_margin_px", stereo.disparity_margin_px);
+  section.read("occlusion_cost", stereo.occlusion_cost);
+  section.read("near_cutoff_m", stereo.near_cutoff_m);
+  section.read("far_cutoff_m", stereo.far_cutoff_m);
+  section.read("one_point_per_degree", stereo.one_point_per_degree);
+  std::string subpixel;
+  section.read("subpixel", subpixel);
+  if (subpixel.empty()) {
+  } else if (subpixel == "none") {
+    stereo.subpixel = stereo::SubpixelMethod::kNone;
+  } else if (subpixel == "edge_peak") {
+    stereo.subpixel = stereo::SubpixelMethod::kEdgePeak;
+  } else if (subpixel == "cost_curve") {
+    stereo.subpixel = stereo::SubpixelMethod::kCostCurve;
+  } else {
+    section.fail("subpixel", "must be none, edge_peak or cost_curve");
+  }
+  std::string triangulation;
+  section.read("triangulation", triangulation);
+  if (triangulation.empty()) {
+  } else if (triangulation == "exact") {
+    stereo.triangulation = stereo::TriangulationMethod::kExact;
+  } else if (triangulation == "table") {
+    stereo.triangulation = stereo::TriangulationMethod::kTable;
+  } else {
+    section.fail("triangulation", "must be exact or table");
+  }
+  if (!(stereo.max_range_m > stereo.min_range_m)) section.fail("max_range_m", "must exceed min_range_m");
+  if (!(stereo.far_cutoff_m > stereo.near_cutoff_m))
+    section.fail("far_cutoff_m", "must exceed near_cutoff_m");
+}
+
+}  // namespace
+
+Config load_config(const std::filesystem::path &file) {
+  const std::string name = file.string();
+  const YAML::Node root = detail::load_yaml(name);
+  Config config;
+  if (!root || root.IsNull()) return config;  // an empty file keeps every default
+  YamlSection top(root, "", name);
+  if (top.has("camera")) {
+    YamlSection camera(top.node("camera"), "camera", name);
+    detail::read_camera_fields(camera, config.scan.camera);
+    camera.read("camera_height_m", config.scan.camera_height_m);
+    if (!(config.scan.camera_height_m > 0.0)) camera.fail("camera_height_m", "must be positive");
+    camera.finish();
+  }
+  if (top.has("vision")) {
+    YamlSection vision(top.node("vision"), "vision", name);
+    read_vision(vision, config.scan.vision);
+    vision.finish();
+  }
+  if (top.has("stereo")) {
+    YamlSection stereo(top.node("stereo"), "stereo", name);
+    read_stereo(stereo, config.scan.stereo);
+    stereo.finish();
+  }
+  top.finish();
+  return config;
+}
+
+}  // namespace omnislam::io

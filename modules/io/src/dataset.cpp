@@ -1,0 +1,52 @@
+#include "omnislam/io/dataset.hpp"
+
+#include <cstdio>
+#include <stdexcept>
+#include <vector>
+
+#include "camera_fields.hpp"
+#include "yaml_fields.hpp"
+
+namespace omnislam::io {
+
+std::filesystem::path DatasetInfo::image(int frame) const {
+  std::vector<char> name(images.size() + 32);
+  std::snprintf(name.data(), name.size(), images.c_str(), frame);
+  return dir / name.data();
+}
+
+DatasetInfo read_dataset_info(const std::filesystem::path &dir) {
+  const std::string file = (dir / "dataset.yaml").string();
+  const YAML::Node root = detail::load_yaml(file);
+  detail::YamlSection top(root, "", file);
+  DatasetInfo info;
+  info.dir = dir;
+  top.read("name", info.name);
+  if (top.has("camera")) {
+    detail::YamlSection camera(top.node("camera"), "camera", file);
+    detail::read_camera_fields(camera, info.camera);
+    camera.finish();
+  }
+  if (top.has("mirror")) {
+    std::string mirror;
+    top.read("mirror", mirror);
+    if (mirror != "thesis-2008") top.fail("mirror", "must be thesis-2008 (the only mirror supported)");
+  }
+  top.read("camera_height_m", info.camera_height_m);
+  top.read("frames", info.frames);
+  top.read("rate_hz", info.rate_hz);
+  top.read("images", info.images);
+  const auto path_of = [&](const char *key, std::filesystem::path &path) {
+    std::string relative;
+    top.read(key, relative);
+    if (!relative.empty()) path = dir / relative;
+  };
+  path_of("groundtruth", info.groundtruth);
+  path_of("odometry", info.odometry);
+  path_of("odometry_exact", info.odometry_exact);
+  path_of("floorplan", info.floorplan);
+  if (info.frames < 0) top.fail("frames", "must be >= 0");
+  return info;
+}
+
+}  // namespace omnislam::io

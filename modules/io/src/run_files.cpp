@@ -1,0 +1,85 @@
+#include "omnislam/io/run_files.hpp"
+
+#include <cstdio>
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+
+namespace omnislam::io {
+namespace {
+
+std::ofstream open_for_writing(const std::filesystem::path &file) {
+  std::ofstream out(file);
+  if (!out) throw std::runtime_error("cannot open " + file.string() + " for writing");
+  return out;
+}
+
+void finish(std::ofstream &out, const std::filesystem::path &file) {
+  if (!out.flush()) throw std::runtime_error("write failed: " + file.string());
+}
+
+}  // namespace
+
+void write_tum_file(const std::filesystem::path &file, const std::vector<StampedPose> &poses) {
+  std::ofstream out = open_for_writing(file);
+  out << "# t x y z qx qy qz qw (base_link in map, metres)\n";
+  char line[256];
+  for (const StampedPose &p : poses) {
+    std::snprintf(line, sizeof line, "%.6f %.9f %.9f %.9f %.9f %.9f %.9f %.9f\n", p.t_s, p.x_m, p.y_m, p.z_m,
+                  p.qx, p.qy, p.qz, p.qw);
+    out << line;
+  }
+  finish(out, file);
+}
+
+void write_map_csv(const std::filesystem::path &file, const std::vector<MapPointRecord> &points) {
+  std::ofstream out = open_for_writing(file);
+  out << "x,y,hits\n";
+  char line[96];
+  for (const MapPointRecord &p : points) {
+    std::snprintf(line, sizeof line, "%.6f,%.6f,%d\n", p.x_m, p.y_m, p.hits);
+    out << line;
+  }
+  finish(out, file);
+}
+
+void write_map_ply(const std::filesystem::path &file, const std::vector<MapPointRecord> &points) {
+  std::ofstream out = open_for_writing(file);
+  out << "ply\nformat ascii 1.0\ncomment omnislam map, metres, map frame\nelement vertex " << points.size()
+      << "\nproperty float x\nproperty float y\nproperty float z\nproperty int hits\nend_header\n";
+  char line[96];
+  for (const MapPointRecord &p : points) {
+    std::snprintf(line, sizeof line, "%.6f %.6f 0 %d\n", p.x_m, p.y_m, p.hits);
+    out << line;
+  }
+  finish(out, file);
+}
+
+std::vector<MapPointRecord> read_map_csv(const std::filesystem::path &file) {
+  std::ifstream in(file);
+  if (!in) throw std::runtime_error("cannot open " + file.string());
+  std::vector<MapPointRecord> points;
+  std::string line;
+  int number = 0;
+  while (std::getline(in, line)) {
+    ++number;
+    if (number == 1 || line.empty()) continue;  // header
+    MapPointRecord p;
+    char comma1 = 0, comma2 = 0;
+    std::istringstream fields(line);
+    if (!(fields >> p.x_m >> comma1 >> p.y_m >> comma2 >> p.hits) || comma1 != ',' || comma2 != ',') {
+      throw std::runtime_error(file.string() + ":" + std::to_string(number) + ": expected x,y,hits, got '" +
+                               line + "'");
+    }
+    points.push_back(p);
+  }
+  return points;
+}
+
+void write_text_file(const std::filesystem::path &file, const std::string &text) {
+  std::ofstream out = open_for_writing(file);
+  out << text;
+  finish(out, file);
+}
+
+}  // namespace omnislam::io

@@ -1,0 +1,88 @@
+#pragma once
+
+#include <yaml-cpp/yaml.h>
+
+#include <set>
+#include <stdexcept>
+#include <string>
+
+// Typed access to one YAML mapping with errors that name the key and file:line (private
+// to io/; the public headers expose plain structs only).
+
+namespace omnislam::io::detail {
+
+[[nodiscard]] inline std::string where(const std::string &file, const YAML::Mark &mark) {
+  if (mark.is_null()) return file;
+  return file + ":" + std::to_string(mark.line + 1) + ":" + std::to_string(mark.column + 1);
+}
+
+/// One mapping ("section") of a YAML file. read() fills known keys; finish() rejects the
+/// keys nobody asked for when the section is strict.
+class YamlSection {
+ public:
+  YamlSection(const YAML::Node &node, std::string prefix, std::string file)
+      : node_(node), prefix_(std::move(prefix)), file_(std::move(file)) {
+    if (!node_.IsMap()) {
+      throw std::runtime_error(where(file_, node_.Mark()) + ": '" + prefix_ + "' must be a mapping of keys");
+    }
+  }
+
+  [[nodiscard]] std::string key_name(const std::string &key) const {
+    return prefix_.empty() ? key : prefix_ + "." + key;
+  }
+
+  [[nodiscard]] bool has(const std::string &key) {
+    seen_.insert(key);
+    return static_cast<bool>(node_[key]);
+  }
+
+  [[nodiscard]] YAML::Node node(const std::string &key) const { return node_[key]; }
+
+  template <typename T>
+  void read(const std::string &key, T &value, const char *expected) {
+    if (!has(key)) return;
+    const YAML::Node field = node_[key];
+    try {
+      value = field.as<T>();
+    } catch (const YAML::Exception &) {
+      throw std::runtime_error(where(file_, field.Mark()) + ": '" + key_name(key) + "' must be " + expected);
+    }
+  }
+
+  void read(const std::string &key, double &value) { read<double>(key, value, "a number"); }
+  void read(const std::string &key, int &value) { read<int>(key, value, "an integer"); }
+  void read(const std::string &key, bool &value) { read<bool>(key, value, "true or false"); }
+  void read(const std::string &key, std::string &value) { read<std::string>(key, value, "a string"); }
+
+  [[noreturn]] void fail(const std::string &key, const std::string &message) const {
+    throw std::runtime_error(where(file_, node_[key].Mark()) + ": '" + key_name(key) + "' " + message);
+  }
+
+  void finish() const {
+    for (const auto &entry : node_) {
+      const auto key = entry.first.as<std::string>();
+      if (!seen_.contains(key)) {
+        throw std::runtime_error(where(file_, entry.first.Mark()) + ": unknown key '" + key_name(key) + "'");
+      }
+    }
+  }
+
+ private:
+  YAML::Node node_;
+  std::string prefix_;
+  std::string file_;
+  std::set<std::string> seen_;
+};
+
+/// Loads a YAML file, turning parse errors into std::runtime_error naming file:line.
+[[nodiscard]] inline YAML::Node load_yaml(const std::string &file) {
+  try {
+    return YAML::LoadFile(file);
+  } catch (const YAML::BadFile &) {
+    throw std::runtime_error(file + ": cannot open the file");
+  } catch (const YAML::ParserException &error) {
+    throw std::runtime_error(where(file, error.mark) + ": " + error.msg);
+  }
+}
+
+}  // namespace omnislam::io::detail

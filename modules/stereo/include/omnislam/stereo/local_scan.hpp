@@ -1,0 +1,59 @@
+#pragma once
+
+#include <vector>
+
+/// @file
+/// The local scan of one image: what the SLAM module consumes.
+/// Frame: base_link (REP-105: x forward, y left, z up; origin on the mirror axis at floor
+/// level), metres and radians.
+
+namespace omnislam::stereo {
+
+struct ScanPoint {
+  double azimuth_rad = 0.0;  ///< atan2(y, x) in [0, 2 pi): the panorama column's azimuth
+  double range_m = 0.0;      ///< horizontal distance from the mirror axis
+  double x_m = 0.0;
+  double y_m = 0.0;
+  double z_m = 0.0;        ///< above the floor: camera_height_m + height relative to the pinhole
+  float inner_row = 0.0f;  ///< matched panorama rows (fractional after sub-pixel refinement)
+  float outer_row = 0.0f;
+};
+
+/// Counts after each step of the reconstruction, for logs, profiles and tests.
+struct LobeStats {
+  int canny_px = 0;             ///< Canny edge pixels
+  int fragment_px_removed = 0;  ///< of which in fragments too small to keep
+  int horizontal_px = 0;        ///< horizontal edge pixels among the runs examined
+  int runs = 0;                 ///< edge runs examined, bottom-up
+  int not_local_max = 0;
+  int low_contrast = 0;
+  int candidates = 0;  ///< edge points handed to the matcher
+  double low_threshold = 0.0;
+  double high_threshold = 0.0;
+};
+
+struct ScanStats {
+  LobeStats inner;
+  LobeStats outer;
+  int admissible_pairs = 0;  ///< candidate pairs inside the disparity band
+  int matched = 0;           ///< pairs chosen by the DP
+  int occluded_inner = 0;
+  int occluded_outer = 0;
+  int no_intersection = 0;  ///< matches whose rays do not meet
+  int outside_cutoffs = 0;  ///< points dropped by the near/far cut-offs
+  int filtered_out = 0;     ///< points dropped by the one-point-per-degree filter
+  int points = 0;           ///< points in the scan
+};
+
+enum class ScanStatus {
+  kOk,
+  kBadImage,  ///< not 8-bit single channel of the configured camera size
+};
+
+struct LocalScan {
+  ScanStatus status = ScanStatus::kOk;
+  std::vector<ScanPoint> points;  ///< ordered by azimuth, then bottom-up within a column
+  ScanStats stats;
+};
+
+}  // namespace omnislam::stereo

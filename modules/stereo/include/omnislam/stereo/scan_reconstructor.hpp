@@ -1,0 +1,84 @@
+#pragma once
+
+#include <array>
+#include <opencv2/core.hpp>
+#include <vector>
+
+#include "omnislam/mirror/mirror_model.hpp"
+#include "omnislam/stereo/column_matching.hpp"
+#include "omnislam/stereo/disparity_limits.hpp"
+#include "omnislam/stereo/local_scan.hpp"
+#include "omnislam/stereo/row_triangulator.hpp"
+#include "omnislam/stereo/stereo_config.hpp"
+#include "omnislam/vision/edge_detector.hpp"
+#include "omnislam/vision/edge_selection.hpp"
+#include "omnislam/vision/panorama_unwarper.hpp"
+
+/// @file
+/// One omnidirectional image -> local scan (thesis sec. 3, steps 1-7).
+
+namespace omnislam::stereo {
+
+/// Working images and candidates of one lobe, reused from frame to frame.
+struct LobeWork {
+  cv::Mat panorama;  ///< CV_8UC1 rows_per_lobe x columns
+  cv::Mat texture;   ///< CV_32FC1 in [0, 1] (Blackman-smoothed when configured)
+  vision::EdgeImage edges;
+  vision::ColumnEdges candidates;
+  vision::SelectionStats selection;
+};
+
+/// Holds everything computed once per camera (remap tables, disparity bands, row
+/// elevations, Blackman kernel) and the per-frame buffers. Not thread-safe: one instance
+/// per thread. The stage methods are public so a profiler can time them; reconstruct()
+/// runs them in order.
+class ScanReconstructor {
+ public:
+  explicit ScanReconstructor(const ScanConfig &config = {});
+
+  /// The whole reconstruction of one 8-bit grey image of the configured size. A wrong
+  /// image gives status kBadImage and no points (no exception).
+  [[nodiscard]] LocalScan reconstruct(const cv::Mat &image);
+  /// The same, reusing `scan`'s storage.
+  void reconstruct(const cv::Mat &image, LocalScan &scan);
+
+  /// Stages, in order. Each reads what the previous one left in the working state.
+  [[nodiscard]] bool accepts(const cv::Mat &image) const;
+  void unwarp(const cv::Mat &image);  ///< step 1, both lobes
+  void detect_edges();                ///< step 2, both lobes
+  void select_edges();                ///< steps 3-4, both lobes
+  void match();                       ///< step 5, every column pair
+  void triangulate(LocalScan &scan);  ///< steps 6-7, with the stats of all steps
+
+  [[nodiscard]] const ScanConfig &config() const { return config_; }
+  [[nodiscard]] const mirror::MirrorModel &model() const { return model_; }
+  [[nodiscard]] const DisparityLimits &disparity_limits() const { return limits_; }
+  [[nodiscard]] const RowTriangulator &triangulator() const { return triangulator_; }
+  [[nodiscard]] const LobeWork &inner() const { return inner_; }
+  [[nodiscard]] const LobeWork &outer() const { return outer_; }
+  [[nodiscard]] const std::vector<RowMatch> &matches() const { return matches_; }
+
+  /// Turns matched rows into scan points with the configured cut-offs and filter; shared
+  /// with other matchers (e.g. a benchmark's StereoSGBM) so they are judged alike.
+  void build_scan(const std::vector<RowMatch> &matches, LocalScan &scan);
+
+ private:
+  ScanConfig config_;
+  mirror::MirrorModel model_;
+  vision::PanoramaUnwarper unwarper_;
+  DisparityLimits limits_;
+  RowTriangulator triangulator_;
+  cv::Mat blackman_;
+  std::vector<double> column_cos_;
+  std::vector<double> column_sin_;
+  std::vector<double> column_azimuth_rad_;
+  vision::EdgeDetector inner_detector_;
+  vision::EdgeDetector outer_detector_;
+  LobeWork inner_;
+  LobeWork outer_;
+  std::vector<RowMatch> matches_;
+  MatchStats match_stats_;
+  std::vector<ScanPoint> filtered_;
+};
+
+}  // namespace omnislam::stereo

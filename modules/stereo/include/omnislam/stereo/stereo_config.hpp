@@ -1,0 +1,50 @@
+#pragma once
+
+#include "omnislam/mirror/mirror_config.hpp"
+#include "omnislam/vision/vision_config.hpp"
+
+/// @file
+/// Settings of the stereo matching and of the local scan (thesis sec. 3 steps 5-7).
+
+namespace omnislam::stereo {
+
+/// How a match is refined below one pixel.
+enum class SubpixelMethod {
+  kNone,      ///< integer rows, as the thesis
+  kEdgePeak,  ///< each lobe's edge row refined by a parabola through its gradient peak
+  /// Disparity from an equiangular fit through SAD at d-1, d, d+1 (at the integer inner
+  /// row), applied at the edge-peak inner row.
+  kCostCurve,
+};
+
+/// How a matched pair of rows becomes a point.
+enum class TriangulationMethod {
+  kExact,  ///< the closed-form model at fractional rows (mirror.md sec. 6)
+  kTable,  ///< the thesis's 225x225 table at rounded integer rows (annex A1.3)
+};
+
+struct StereoConfig {
+  /// Disparity search band, derived per inner row from the mirror model (no fixed
+  /// 10..90 px): only points with horizontal range in [min_range_m, max_range_m] at or
+  /// above the floor are searched for, widened by disparity_margin_px on both sides.
+  double min_range_m = 0.3;
+  double max_range_m = 6.0;
+  double disparity_margin_px = 1.0;
+  double occlusion_cost = 2.5;  ///< DP cost of leaving an edge point unmatched (CustoOclusao)
+  SubpixelMethod subpixel = SubpixelMethod::kEdgePeak;
+  TriangulationMethod triangulation = TriangulationMethod::kExact;
+  /// Scan cut-offs on the horizontal range (thesis Corte_inferior / Corte_superior).
+  double near_cutoff_m = 0.3;
+  double far_cutoff_m = 5.0;
+  bool one_point_per_degree = true;  ///< keep the nearest point of each degree (thesis Filtro)
+};
+
+/// Everything one image needs to become a local scan.
+struct ScanConfig {
+  mirror::MirrorConfig camera;   ///< camera intrinsics, mirror, pixel split, azimuth offset
+  double camera_height_m = 1.0;  ///< pinhole F0 above the floor (base_link origin)
+  vision::VisionConfig vision;
+  StereoConfig stereo;
+};
+
+}  // namespace omnislam::stereo

@@ -1,0 +1,158 @@
+#include "omnislam/stereo/scan_reconstructor.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <numbers>
+
+#include "omnislam/mirror/panorama_maps.hpp"
+#include "omnislam/vision/texture.hpp"
+
+namespace omnislam::stereo {
+namespace {
+
+constexpr double kTwoPi = 2.0 * std::numbers::pi;
+constexpr int kDegreeBins = 360;
+
+LobeStats lobe_stats(const LobeWork &work) {
+  LobeStats stats;
+  stats.canny_px = work.edges.canny_px;
+  stats.fragment_px_removed = work.edges.fragment_px_removed;
+  stats.low_threshold = work.edges.low_threshold;
+  stats.high_threshold = work.edges.high_threshold;
+  stats.horizontal_px = work.selection.horizontal_px;
+  stats.runs = work.selection.runs;
+  stats.not_local_max = work.selection.not_local_max;
+  stats.low_contrast = work.selection.low_contrast;
+  stats.candidates = work.selection.selected;
+  return stats;
+}
+
+// Thesis Filtro: of each degree of azimuth keep only the point nearest the robot. Returns
+// how many points were dropped; the survivors come out in azimuth order.
+int keep_nearest_per_degree(std::vector<ScanPoint> &points, std::vector<ScanPoint> &scratch) {
+  constexpr std::size_t kNone = static_cast<std::size_t>(-1);
+  std::array<std::size_t, kDegreeBins> nearest;
+  nearest.fill(kNone);
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    const auto bin = std::min<std::size_t>(
+        kDegreeBins - 1, static_cast<std::size_t>(points[i].azimuth_rad / kTwoPi * kDegreeBins));
+    if (nearest[bin] == kNone || points[i].range_m < points[nearest[bin]].range_m) nearest[bin] = i;
+  }
+  scratch.clear();
+  for (const std::size_t index : nearest) {
+    if (index != kNone) scratch.push_back(points[index]);
+  }
+  const auto dropped = static_cast<int>(points.size() - scratch.size());
+  std::swap(points, scratch);
+  return dropped;
+}
+
+}  // namespace
+
+ScanReconstructor::ScanReconstructor(const ScanConfig &config)
+    : config_(config),
+      model_(config.camera),
+      unwarper_(model_),
+      limits_(derive_disparity_limits(model_, config.camera_height_m, config.stereo.min_range_m,
+                                      config.stereo.max_range_m, config.stereo.disparity_margin_px)),
+      triangulator_(model_, config.stereo.triangulation),
+      inner_detector_(config.vision.canny),
+      outer_detector_(config.vision.canny) {
+  if (config.vision.selection.blackman_smoothing) blackman_ = vision::blackman_kernel(7);
+  for (int column = 0; column < config.camera.columns; ++column) {
+    const double azimuth =
+        std::fmod(std::fmod(mirror::column_azimuth_rad(config.camera, column), kTwoPi) + kTwoPi, kTwoPi);
+    column_azimuth_rad_.push_back(azimuth);
+    column_cos_.push_back(std::cos(azimuth));
+    column_sin_.push_back(std::sin(azimuth));
+  }
+  matches_.reserve(static_cast<std::size_t>(config.camera.columns) * 4);
+}
+
+LocalScan ScanReconstructor::reconstruct(const cv::Mat &image) {
+  LocalScan scan;
+  reconstruct(image, scan);
+  return scan;
+}
+
+void ScanReconstructor::reconstruct(const cv::Mat &image, LocalScan &scan) {
+  scan.points.clear();
+  scan.stats = {};
+  if (!accepts(image)) {
+    scan.status = ScanStatus::kBadImage;
+    return;
+  }
+  scan.status = ScanStatus::kOk;
+  unwarp(image);      // 1. both lobes -> 225 x 360 panoramas
+  detect_edges();     // 2. Canny + removal of tiny fragments
+  select_edges();     // 3-4. nearest horizontal edges, local maxima, contrast test
+  match();            // 5. DP along every inner/outer column pair
+  triangulate(scan);  // 6-7. exact triangulation, cut-offs, one point per degree
+}
+
+bool ScanReconstructor::accepts(const cv::Mat &image) const {
+  return !image.empty() && image.type() == CV_8UC1 && image.cols == config_.camera.image_width_px &&
+         image.rows == config_.camera.image_height_px;
+}
+
+void ScanReconstructor::unwarp(const cv::Mat &image) {
+  unwarper_.unwarp(image, mirror::Lobe::kInner, inner_.panorama);
+  unwarper_.unwarp(image, mirror::Lobe::kOuter, outer_.panorama);
+}
+
+void ScanReconstructor::detect_edges() {
+  inner_detector_.detect(inner_.panorama, inner_.edges);
+  outer_detector_.detect(outer_.panorama, outer_.edges);
+}
+
+void ScanReconstructor::select_edges() {
+  for (LobeWork *work : {&inner_, &outer_}) {
+    vision::make_texture(work->panorama, blackman_, work->texture);
+    work->selection = vision::select_nearest_horizontal_edges(work->edges, work->texture,
+                                                              config_.vision.selection, work->candidates);
+  }
+}
+
+void ScanReconstructor::match() {
+  matches_.clear();
+  match_stats_ = {};
+  for (int column = 0; column < inner_.candidates.columns(); ++column) {
+    match_column(inner_.candidates.column(column), outer_.candidates.column(column), column, inner_.texture,
+                 outer_.texture, limits_, config_.vision.selection, config_.stereo, matches_, match_stats_);
+  }
+}
+
+void ScanReconstructor::triangulate(LocalScan &scan) {
+  scan.stats.inner = lobe_stats(inner_);
+  scan.stats.outer = lobe_stats(outer_);
+  scan.stats.admissible_pairs = match_stats_.admissible_pairs;
+  scan.stats.matched = match_stats_.matched;
+  scan.stats.occluded_inner = match_stats_.occluded_inner;
+  scan.stats.occluded_outer = match_stats_.occluded_outer;
+  build_scan(matches_, scan);
+}
+
+void ScanReconstructor::build_scan(const std::vector<RowMatch> &matches, LocalScan &scan) {
+  const StereoConfig &stereo = config_.stereo;
+  scan.points.clear();
+  for (const RowMatch &match : matches) {
+    const auto point = triangulator_.triangulate(match.inner_row, match.outer_row);
+    if (!point) {
+      ++scan.stats.no_intersection;
+      continue;
+    }
+    if (point->range_m < stereo.near_cutoff_m || point->range_m > stereo.far_cutoff_m) {
+      ++scan.stats.outside_cutoffs;
+      continue;
+    }
+    const auto column = static_cast<std::size_t>(match.column);
+    scan.points.push_back({column_azimuth_rad_[column], point->range_m, point->range_m * column_cos_[column],
+                           point->range_m * column_sin_[column], config_.camera_height_m + point->height_m,
+                           match.inner_row, match.outer_row});
+  }
+  if (stereo.one_point_per_degree) scan.stats.filtered_out = keep_nearest_per_degree(scan.points, filtered_);
+  scan.stats.points = static_cast<int>(scan.points.size());
+}
+
+}  // namespace omnislam::stereo

@@ -1,0 +1,48 @@
+#pragma once
+
+#include <opencv2/core.hpp>
+#include <vector>
+
+#include "omnislam/vision/vision_config.hpp"
+
+/// @file
+/// Canny edges of one panorama (thesis sec. 3 step 2): Gaussian smoothing, Sobel gradient,
+/// OpenCV's hysteresis on the L2 magnitude, then removal of tiny edge fragments.
+
+namespace omnislam::vision {
+
+/// The edge map of one panorama together with the gradient it was computed from.
+/// "Row" gradient is d/d(row) (along a panorama column, i.e. radial in the omni image).
+struct EdgeImage {
+  cv::Mat grad_row;            ///< CV_16SC1, Sobel d/d(row) of the smoothed panorama
+  cv::Mat grad_col;            ///< CV_16SC1, Sobel d/d(column)
+  cv::Mat edges;               ///< CV_8UC1, 255 on an edge pixel
+  double low_threshold = 0.0;  ///< hysteresis thresholds actually used
+  double high_threshold = 0.0;
+  int canny_px = 0;             ///< edge pixels out of Canny
+  int fragment_px_removed = 0;  ///< of which in fragments below min_fragment_px
+};
+
+/// Keeps its scratch images between calls, so steady-state frames allocate nothing.
+/// Not thread-safe: use one detector per thread.
+class EdgeDetector {
+ public:
+  explicit EdgeDetector(const CannyConfig &config = {});
+
+  /// Edges of an 8-bit single-channel panorama into `out` (buffers reused).
+  void detect(const cv::Mat &panorama, EdgeImage &out);
+
+  [[nodiscard]] const CannyConfig &config() const { return config_; }
+
+ private:
+  void choose_thresholds(EdgeImage &out);
+  void remove_fragments(EdgeImage &out);
+
+  CannyConfig config_;
+  cv::Size kernel_size_;
+  cv::Mat smoothed_;
+  std::vector<int> stack_;  ///< flood-fill scratch (pixel indices)
+  std::vector<int> component_;
+};
+
+}  // namespace omnislam::vision

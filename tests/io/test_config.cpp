@@ -1,0 +1,92 @@
+#include <catch2/catch.hpp>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include "omnislam/io/config.hpp"
+
+namespace fs = std::filesystem;
+
+namespace {
+
+fs::path write_file(const std::string &name, const std::string &text) {
+  const fs::path dir = fs::temp_directory_path() / "omnislam-test-config";
+  fs::create_directories(dir);
+  const fs::path file = dir / name;
+  std::ofstream(file) << text;
+  return file;
+}
+
+}  // namespace
+
+TEST_CASE("config: every section read on top of the defaults", "[io][config]") {
+  const fs::path file = write_file("full.yaml",
+                                   "# a comment\n"
+                                   "camera:\n"
+                                   "  width: 800\n"
+                                   "  height: 600\n"
+                                   "  center_px: [399.5, 299.5]\n"
+                                   "  azimuth_offset_deg: 12.5\n"
+                                   "  camera_height_m: 0.8\n"
+                                   "vision:\n"
+                                   "  sigma_px: 1.5\n"
+                                   "  auto_thresholds: false\n"
+                                   "  max_edges_per_column: 6\n"
+                                   "  blackman_smoothing: true\n"
+                                   "stereo:\n"
+                                   "  occlusion_cost: 3.0\n"
+                                   "  subpixel: cost_curve\n"
+                                   "  triangulation: table\n"
+                                   "  far_cutoff_m: 2.0\n");
+  const omnislam::io::Config config = omnislam::io::load_config(file);
+  const auto &scan = config.scan;
+  CHECK(scan.camera.image_width_px == 800);
+  CHECK(scan.camera.image_height_px == 600);
+  CHECK(scan.camera.center_u_px == 399.5);
+  CHECK(scan.camera.center_v_px == 299.5);
+  CHECK(scan.camera.azimuth_offset_deg == 12.5);
+  CHECK(scan.camera.focal_mm == 25.0);  // default kept
+  CHECK(scan.camera_height_m == 0.8);
+  CHECK(scan.vision.canny.sigma_px == 1.5);
+  CHECK_FALSE(scan.vision.canny.auto_thresholds);
+  CHECK(scan.vision.selection.max_edges_per_column == 6);
+  CHECK(scan.vision.selection.blackman_smoothing);
+  CHECK(scan.vision.selection.min_relative_contrast == 0.15);
+  CHECK(scan.stereo.occlusion_cost == 3.0);
+  CHECK(scan.stereo.subpixel == omnislam::stereo::SubpixelMethod::kCostCurve);
+  CHECK(scan.stereo.triangulation == omnislam::stereo::TriangulationMethod::kTable);
+  CHECK(scan.stereo.far_cutoff_m == 2.0);
+  CHECK(scan.stereo.near_cutoff_m == 0.3);
+}
+
+TEST_CASE("config: an empty file keeps the defaults", "[io][config]") {
+  const omnislam::io::Config config = omnislam::io::load_config(write_file("empty.yaml", ""));
+  CHECK(config.scan.camera_height_m == 1.0);
+  CHECK(config.scan.stereo.subpixel == omnislam::stereo::SubpixelMethod::kEdgePeak);
+}
+
+TEST_CASE("config: unknown keys and wrong types name the key and file:line", "[io][config]") {
+  const fs::path unknown = write_file("unknown.yaml", "vision:\n  sigma_px: 1.0\n  sigmaa: 2\n");
+  CHECK_THROWS_WITH(omnislam::io::load_config(unknown),
+                    Catch::Contains("unknown.yaml:3:") && Catch::Contains("unknown key 'vision.sigmaa'"));
+  const fs::path section = write_file("section.yaml", "camera: {}\nslam_typo: {}\n");
+  CHECK_THROWS_WITH(omnislam::io::load_config(section),
+                    Catch::Contains("section.yaml:2:") && Catch::Contains("'slam_typo'"));
+  const fs::path type = write_file("type.yaml", "stereo:\n  occlusion_cost: high\n");
+  CHECK_THROWS_WITH(
+      omnislam::io::load_config(type),
+      Catch::Contains("type.yaml:2:") && Catch::Contains("'stereo.occlusion_cost' must be a number"));
+  const fs::path integer = write_file("integer.yaml", "vision:\n  max_edges_per_column: 2.5\n");
+  CHECK_THROWS_WITH(omnislam::io::load_config(integer),
+                    Catch::Contains("integer.yaml:2:") && Catch::Contains("must be an integer"));
+  const fs::path choice = write_file("choice.yaml", "stereo:\n  subpixel: magic\n");
+  CHECK_THROWS_WITH(omnislam::io::load_config(choice),
+                    Catch::Contains("choice.yaml:2:") && Catch::Contains("none, edge_peak or cost_curve"));
+  const fs::path center = write_file("center.yaml", "camera:\n  center_px: 511.5\n");
+  CHECK_THROWS_WITH(omnislam::io::load_config(center),
+                    Catch::Contains("center.yaml:2:") && Catch::Contains("camera.center_px"));
+  const fs::path syntax = write_file("syntax.yaml", "camera:\n  width: [1, 2\n");
+  CHECK_THROWS_WITH(omnislam::io::load_config(syntax), Catch::Contains("syntax.yaml:"));
+  CHECK_THROWS_WITH(omnislam::io::load_config("/nonexistent/omnislam.yaml"),
+                    Catch::Contains("/nonexistent/omnislam.yaml"));
+}

@@ -1,0 +1,81 @@
+#include <catch2/catch.hpp>
+#include <filesystem>
+#include <fstream>
+#include <numbers>
+#include <opencv2/imgcodecs.hpp>
+#include <string>
+
+#include "omnislam/io/dataset.hpp"
+#include "omnislam/io/ground_truth_files.hpp"
+#include "omnislam/io/image_file.hpp"
+
+namespace fs = std::filesystem;
+
+namespace {
+
+fs::path scratch(const std::string &name) {
+  const fs::path dir = fs::temp_directory_path() / "omnislam-test-files" / name;
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  return dir;
+}
+
+}  // namespace
+
+TEST_CASE("camera images: grey or colour in, grey out; bad files name the file", "[io][image]") {
+  const fs::path dir = scratch("images");
+  const omnislam::mirror::MirrorConfig camera;
+  cv::Mat colour(1024, 1024, CV_8UC3, cv::Scalar(10, 200, 30));
+  cv::imwrite((dir / "colour.png").string(), colour);
+  const cv::Mat grey = omnislam::io::read_camera_image(dir / "colour.png", camera);
+  CHECK(grey.type() == CV_8UC1);
+  CHECK(grey.rows == 1024);
+  cv::imwrite((dir / "small.png").string(), cv::Mat(100, 120, CV_8UC1, cv::Scalar(0)));
+  CHECK_THROWS_WITH(
+      omnislam::io::read_camera_image(dir / "small.png", camera),
+      Catch::Contains("small.png") && Catch::Contains("120x100") && Catch::Contains("1024x1024"));
+  std::ofstream(dir / "empty.png").flush();
+  CHECK_THROWS_WITH(omnislam::io::read_camera_image(dir / "empty.png", camera),
+                    Catch::Contains("empty.png") && Catch::Contains("empty"));
+  std::ofstream(dir / "text.png") << "not an image at all";
+  CHECK_THROWS_WITH(omnislam::io::read_camera_image(dir / "text.png", camera),
+                    Catch::Contains("text.png") && Catch::Contains("not a readable image"));
+  CHECK_THROWS_WITH(omnislam::io::read_camera_image(dir / "missing.png", camera),
+                    Catch::Contains("missing.png") && Catch::Contains("no such"));
+}
+
+TEST_CASE("dataset.yaml, groundtruth.tum and floorplan.csv", "[io][dataset]") {
+  const fs::path dir = scratch("dataset");
+  std::ofstream(dir / "dataset.yaml")
+      << "name: tiny\n"
+         "camera: {width: 1024, height: 1024, center_px: [511.5, 511.5], focal_mm: 25.0, "
+         "pixel_pitch_mm: 0.00702051}\n"
+         "mirror: thesis-2008\ncamera_height_m: 0.9\nframes: 2\nrate_hz: 5\n"
+         "images: images/%06d.png\ngroundtruth: groundtruth.tum\nfloorplan: floorplan.csv\n"
+         "odometry_noise: {model: thesis, seed: 1}\n";
+  const omnislam::io::DatasetInfo info = omnislam::io::read_dataset_info(dir);
+  CHECK(info.name == "tiny");
+  CHECK(info.frames == 2);
+  CHECK(info.camera_height_m == 0.9);
+  CHECK(info.camera.pixel_pitch_mm == 0.00702051);
+  CHECK(info.image(2) == dir / "images/000002.png");
+  CHECK(info.floorplan == dir / "floorplan.csv");
+
+  std::ofstream(dir / "groundtruth.tum")
+      << "# t x y z qx qy qz qw\n0 1 2 0 0 0 0 1\n\n"
+      << "0.2 1.5 2 0 0 0 " << std::sin(0.25) << " " << std::cos(0.25) << "\n";
+  const auto poses = omnislam::io::read_tum_file(dir / "groundtruth.tum");
+  REQUIRE(poses.size() == 2);
+  CHECK(poses[1].x_m == 1.5);
+  CHECK(poses[1].yaw_rad() == Approx(0.5));
+  std::ofstream(dir / "floorplan.csv") << "x1,y1,x2,y2\n0,0,4,0\n4,0,4,8\n";
+  const auto segments = omnislam::io::read_floorplan_csv(dir / "floorplan.csv");
+  REQUIRE(segments.size() == 2);
+  CHECK(segments[1].y2_m == 8.0);
+
+  std::ofstream(dir / "bad.tum") << "0 1 2 3\n";
+  CHECK_THROWS_WITH(omnislam::io::read_tum_file(dir / "bad.tum"), Catch::Contains("bad.tum:1"));
+  std::ofstream(dir / "dataset.yaml") << "frames: many\n";
+  CHECK_THROWS_WITH(omnislam::io::read_dataset_info(dir),
+                    Catch::Contains("dataset.yaml:1:") && Catch::Contains("'frames'"));
+}

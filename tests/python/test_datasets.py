@@ -1,0 +1,271 @@
+"""Tests of scripts/render-dataset: metadata, odometry, floor plan, rendering.
+
+Run from the repository root:  python3 -m pytest tests/python -q
+"""
+from __future__ import annotations
+
+import math
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+import yaml
+
+from conftest import DATASET_NAMES, REPO, SCRIPTS
+from helpers import angle_diff, poses, steps, table_mm, times
+
+from omnislam_render import convention, datasets, geocheck, mirror, odometry
+from omnislam_render.pngio import read_png
+
+RENDER = [sys.executable, str(SCRIPTS / "render-dataset")]
+
+# World (room-frame) pose lists the datasets are built from, per the brief.
+EXPECTED_POINTS = {
+    "sim-room-10": table_mm("3.1"),
+    "sim-room-37": table_mm("3.2"),
+    "sim-room-turning": table_mm("3.2"),
+    "l-room-1lap": table_mm("3.3") + table_mm("3.3")[:1],
+    "l-room-2laps": table_mm("3.3") * 2 + table_mm("3.3")[:1],
+}
+EXPECTED_FRAMES = {"sim-room-10": 10, "sim-room-37": 37, "sim-room-turning": 37,
+                   "l-room-1lap": 60, "l-room-2laps": 119}
+
+
+# ---------------------------------------------------------------------------- metadata
+@pytest.mark.parametrize("name", DATASET_NAMES)
+def test_dataset_yaml_keys(metadata_dir, name):
+    meta = yaml.safe_load((metadata_dir / name / "dataset.yaml").read_text())
+    assert list(meta) == ["name", "camera", "mirror", "camera_height_m", "frames", "rate_hz", "images",
+                          "groundtruth", "odometry", "odometry_exact", "odometry_noise", "floorplan"]
+    assert meta["name"] == name
+    assert meta["camera"] == {"width": 1024, "height": 1024, "center_px": [511.5, 511.5],
+                              "focal_mm": 25.0, "pixel_pitch_mm": pytest.approx(0.00702051, abs=1e-8)}
+    assert meta["mirror"] == "thesis-2008"
+    assert meta["camera_height_m"] == 1.0
+    assert meta["frames"] == EXPECTED_FRAMES[name]
+    assert meta["rate_hz"] == 10
+    assert meta["images"] == "images/%06d.png"
+    assert meta["odometry_noise"] == {"model": "thesis", "seed": 1}
+    for key in ("groundtruth", "odometry", "odometry_exact", "floorplan"):
+        assert (metadata_dir / name / meta[key]).is_file()
+
+
+@pytest.mark.parametrize("name", DATASET_NAMES)
+def test_groundtruth_reproduces_trajectory_table(metadata_dir, name):
+    gt = poses(metadata_dir / name / "groundtruth.tum")
+    pts = EXPECTED_POINTS[name]
+    assert len(gt) == len(pts) == EXPECTED_FRAMES[name]
+    assert times(metadata_dir / name / "groundtruth.tum") == pytest.approx([i / 10 for i in range(len(gt))])
+    # Map frame = first pose: for a constant heading the table relative to point 1;
+    # when turning, also rotated by the first heading (towards point 2).
+    yaw0 = 0.0
+    if name == "sim-room-turning":
+        yaw0 = math.atan2(pts[1][1] - pts[0][1], pts[1][0] - pts[0][0])
+    c, s = math.cos(yaw0), math.sin(yaw0)
+    for (x, y, yaw), (px, py) in zip(gt, pts):
+        dx, dy = (px - pts[0][0]) / 1000.0, (py - pts[0][1]) / 1000.0
+        assert x == pytest.approx(c * dx + s * dy, abs=1e-9)
+        assert y == pytest.approx(-s * dx + c * dy, abs=1e-9)
+        if name != "sim-room-turning":
+            assert abs(yaw) < 1e-12
+
+
+def test_turning_headings_face_travel_and_turn_smoothly(metadata_dir):
+    gt = poses(metadata_dir / "sim-room-turning" / "groundtruth.tum")
+    yaw_steps = [abs(angle_diff(b[2], a[2])) for a, b in zip(gt[:-1], gt[1:])]
+    # The sharpest turn (90 deg) is spread over several poses.
+    assert max(yaw_steps) <= math.radians(90.0 / 4) + 1e-9
+    turning = [i for i, d in enumerate(yaw_steps) if d > 1e-9]
+    assert len(turning) >= 12            # 4 corners x >= 3 steps
+    # On the straight parts the robot faces its direction of travel.
+    facing = 0
+    for a, b in zip(gt[:-1], gt[1:]):
+        travel = math.atan2(b[1] - a[1], b[0] - a[0])
+        if abs(angle_diff(a[2], travel)) < 1e-9 and abs(angle_diff(b[2], travel)) < 1e-9:
+            facing += 1
+    assert facing >= 20
+
+
+@pytest.mark.parametrize("name", DATASET_NAMES)
+def test_trajectory_clears_every_object(name):
+    spec = datasets.DATASETS[name]
+    room, world = spec.room(), spec.world_poses()
+    for a, b in zip(world[:-1], world[1:]):
+        for t in np.linspace(0.0, 1.0, 21):
+            x, y = a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1])
+            dist, what = room.clearance(x, y)
+            assert dist >= 0.45, f"({x:.3f}, {y:.3f}) is {dist:.3f} m from {what}"
+
+
+# ---------------------------------------------------------------------------- odometry
+@pytest.mark.parametrize("name", DATASET_NAMES)
+def test_exact_odometry_is_groundtruth(metadata_dir, name):
+    gt = poses(metadata_dir / name / "groundtruth.tum")
+    exact = poses(metadata_dir / name / "odometry_exact.tum")
+    assert len(exact) == len(gt)
+    for p, q in zip(exact, gt):
+        assert abs(p[0] - q[0]) < 1e-9 and abs(p[1] - q[1]) < 1e-9
+        assert abs(angle_diff(p[2], q[2])) < 1e-9
+    # composing the exact increments again gives the ground truth
+    again = odometry.dead_reckon(steps(exact))
+    for p, q in zip(again, gt):
+        assert abs(p[0] - q[0]) < 1e-9 and abs(p[1] - q[1]) < 1e-9
+        assert abs(angle_diff(p[2], q[2])) < 1e-9
+
+
+@pytest.mark.parametrize("name", DATASET_NAMES)
+def test_noisy_odometry_respects_model_bounds(metadata_dir, name):
+    gt = poses(metadata_dir / name / "groundtruth.tum")
+    noisy = poses(metadata_dir / name / "odometry.tum")
+    assert noisy[0] == (0.0, 0.0, 0.0)
+    scales, yaw_errors = [], []
+    for true, meas in zip(steps(gt), steps(noisy)):
+        length, length_meas = math.hypot(true[0], true[1]), math.hypot(meas[0], meas[1])
+        if length > 1e-9:
+            scales.append(length_meas / length)
+            # direction in the robot frame kept
+            assert abs(angle_diff(math.atan2(meas[1], meas[0]), math.atan2(true[1], true[0]))) < 1e-6
+        else:
+            assert length_meas < 1e-9
+        err = angle_diff(meas[2], true[2])
+        bound = max(0.10 * abs(true[2]), math.radians(1.5))
+        assert abs(err) <= bound + 1e-9
+        yaw_errors.append(err)
+    scales = np.array(scales)
+    assert scales.min() >= 0.9 - 1e-9 and scales.max() <= 1.1 + 1e-9
+    assert np.abs(scales - 1).max() > 0.01        # noise was applied
+    assert np.abs(yaw_errors).max() > math.radians(0.3)
+
+
+def test_noisy_odometry_reproducible_and_seeded(metadata_dir, tmp_path):
+    name = "sim-room-37"
+    datasets.build(name, tmp_path / "again", images=False, log=lambda *_: None)
+    first = (metadata_dir / name / "odometry.tum").read_bytes()
+    assert (tmp_path / "again" / "odometry.tum").read_bytes() == first
+    gt = poses(metadata_dir / name / "groundtruth.tum")
+    seeded = odometry.odometry(gt, 1)
+    other = odometry.odometry(gt, 2)
+    written = poses(metadata_dir / name / "odometry.tum")
+    assert np.abs(np.array(written) - np.array(seeded)).max() < 1e-9
+    assert max(abs(a[0] - b[0]) + abs(a[1] - b[1]) for a, b in zip(seeded, other)) > 1e-3
+    exact = poses(metadata_dir / name / "odometry_exact.tum")
+    assert max(math.hypot(a[0] - b[0], a[1] - b[1]) for a, b in zip(seeded, exact)) > 1e-2
+
+
+@pytest.mark.parametrize("name", DATASET_NAMES)
+def test_thesis_odometry_txt_matches_tum(metadata_dir, name):
+    path = metadata_dir / name / "odometry.txt"
+    if name == "sim-room-turning":
+        assert not path.exists()          # heading not constant: no thesis-format file
+        return
+    pairs = odometry.read_thesis_odometry(path)
+    noisy = poses(metadata_dir / name / "odometry.tum")
+    assert len(pairs) == len(noisy)
+    assert pairs[0] == (0.0, 0.0)
+    x = y = 0.0
+    for (dist_mm, angle_deg), pose in zip(pairs, noisy):
+        x += dist_mm / 1000.0 * math.cos(math.radians(angle_deg))
+        y += dist_mm / 1000.0 * math.sin(math.radians(angle_deg))
+        assert x == pytest.approx(pose[0], abs=1e-6) and y == pytest.approx(pose[1], abs=1e-6)
+
+
+# ---------------------------------------------------------------------------- floor plan
+def _floorplan(path):
+    lines = path.read_text().splitlines()
+    assert lines[0] == "x1,y1,x2,y2"
+    return np.array([[float(v) for v in ln.split(",")] for ln in lines[1:]])
+
+
+def test_floorplan_sim_room(metadata_dir):
+    segs = _floorplan(metadata_dir / "sim-room-37" / "floorplan.csv")
+    # map frame = pose 1 at room (3, 1.5): the walls x = -4, 4 and y = -2, 2 become
+    # x = -7, 1 and y = -3.5, 0.5
+    xs, ys = segs[:, [0, 2]], segs[:, [1, 3]]
+    assert xs.min() == pytest.approx(-7.0) and xs.max() == pytest.approx(1.0)
+    assert ys.min() == pytest.approx(-3.5) and ys.max() == pytest.approx(0.5)
+    # 4 walls + 2 cabinets, table top, platform, board, 4 boxes (4 sides each)
+    # + table column and sphere (24 sides each)
+    assert len(segs) == 4 + 4 * 9 + 24 * 2
+    lengths = np.hypot(segs[:, 2] - segs[:, 0], segs[:, 3] - segs[:, 1])
+    assert np.isclose(lengths, 8.0).sum() == 2 and np.isclose(lengths, 4.0).sum() == 2
+
+
+def test_floorplan_l_room(metadata_dir):
+    segs = _floorplan(metadata_dir / "l-room-1lap" / "floorplan.csv")
+    walls = segs[:6]
+    assert np.ptp(walls[:, [0, 2]]) == pytest.approx(6.9)
+    assert len(segs) == 6 + 3 * 5 * 4 + 2 * 4   # walls, three 4-legged tables, cabinet, crate
+
+
+def test_frames_option_limits_metadata(tmp_path):
+    out = tmp_path / "ds"
+    subprocess.run(RENDER + ["l-room-2laps", "--out", str(out), "--frames", "7", "--no-images"],
+                   check=True, capture_output=True, cwd=REPO)
+    meta = yaml.safe_load((out / "dataset.yaml").read_text())
+    assert meta["frames"] == 7
+    for f in ("groundtruth.tum", "odometry.tum", "odometry_exact.tum"):
+        assert len(poses(out / f)) == 7
+    assert len(odometry.read_thesis_odometry(out / "odometry.txt")) == 7
+    assert not (out / "images").exists()
+
+
+# ---------------------------------------------------------------------------- rendering
+def test_convention_check_matches_reference(tmp_path):
+    png = tmp_path / "convention.png"
+    convention.render_convention(png)
+    img, ref = read_png(png), read_png(convention.DATA_DIR / "image.png")
+    stats = convention.compare(img, ref)
+    assert stats["mean_abs"] < 0.1
+    assert stats["px_diff_gt_32"] < 100
+    assert stats["red"]["mean_az_deg"] == pytest.approx(stats["red"]["ref_mean_az_deg"], abs=0.1)
+    assert stats["blue"]["mean_az_deg"] == pytest.approx(90.0, abs=0.1)
+    # the red cube (centre azimuth 18.4 deg) in both lobes, the blue one at 90 deg
+    for colour, expected in (("red", 19.0), ("blue", 90.0)):
+        az = convention.colour_azimuths_deg(img, colour)
+        assert np.median(az) == pytest.approx(expected, abs=1.5)
+    rgb = img.astype(int)
+    vv, uu = np.nonzero((rgb[..., 0] > 120) & (rgb[..., 0] > 2 * rgb[..., 1]) & (rgb[..., 0] > 2 * rgb[..., 2]))
+    radius = np.hypot(uu - 511.5, vv - 511.5)
+    assert (radius < mirror.R_SPLIT_PX).sum() > 500 and (radius > mirror.R_SPLIT_PX).sum() > 500
+
+
+def test_mirror_geometry_matches_model():
+    """Every pixel's ray hits the floor where mirror.md's back-projection says."""
+    result = geocheck.check(range_mm=20000.0)
+    for lobe in ("inner", "outer"):
+        assert result[lobe]["pixels"] > 150000
+        assert result[lobe]["median_abs_px"] < 0.01
+        assert result[lobe]["max_abs_px"] < 0.05
+        assert result[lobe]["max_abs_az_deg"] < 0.01
+
+
+def test_render_is_deterministic(tmp_path):
+    outs = [tmp_path / "a", tmp_path / "b"]
+    for out in outs:
+        subprocess.run(RENDER + ["sim-room-37", "--out", str(out), "--frames", "2"],
+                       check=True, capture_output=True, cwd=REPO)
+    for i in (1, 2):
+        a = (outs[0] / "images" / f"{i:06d}.png").read_bytes()
+        b = (outs[1] / "images" / f"{i:06d}.png").read_bytes()
+        assert a == b
+    assert sorted(p.name for p in (outs[0] / "images").iterdir()) == ["000001.png", "000002.png"]
+    img = read_png(outs[0] / "images" / "000001.png")
+    assert img.shape == (1024, 1024, 3) and img.dtype == np.uint8
+    # black centre and corners, mirror content in both annuli
+    assert img[511, 511].max() == 0 and img[0, 0].max() == 0
+    assert img[511, 511 + 150].max() > 0 and img[511, 511 + 400].max() > 0
+
+
+def test_identical_poses_reuse_images(tmp_path):
+    """l-room-2laps reuses l-room-1lap's images of the same poses (no re-render)."""
+    one = tmp_path / "l-room-1lap"
+    datasets.build("l-room-1lap", one, frames=3, images=False, log=lambda *_: None)
+    (one / "images").mkdir()
+    for i in (1, 2, 3):
+        (one / "images" / f"{i:06d}.png").write_bytes(b"frame %d" % i)
+    two = tmp_path / "l-room-2laps"
+    stats = datasets.build("l-room-2laps", two, frames=3, log=lambda *_: None)
+    assert stats["rendered"] == 0 and stats["reused"] == 3
+    for i in (1, 2, 3):
+        assert (two / "images" / f"{i:06d}.png").read_bytes() == b"frame %d" % i

@@ -1,0 +1,147 @@
+#include <catch2/catch.hpp>
+#include <cstdint>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+#include <string>
+
+#include "omnislam/mirror/mirror_model.hpp"
+#include "omnislam/vision/edge_detector.hpp"
+#include "omnislam/vision/edge_selection.hpp"
+#include "omnislam/vision/panorama_unwarper.hpp"
+#include "omnislam/vision/texture.hpp"
+
+using omnislam::mirror::Lobe;
+using omnislam::mirror::MirrorModel;
+using namespace omnislam::vision;
+
+namespace {
+
+const std::string kConventionImage = OMNISLAM_CONVENTION_IMAGE;
+
+// A panorama-sized image: dark below `boundary_row` in every column, light above.
+cv::Mat step_panorama(double boundary_row) {
+  cv::Mat pano(225, 360, CV_8UC1);
+  for (int row = 0; row < pano.rows; ++row) {
+    const double light = std::clamp(boundary_row - row + 0.5, 0.0, 1.0);  // area coverage
+    pano.row(row).setTo(static_cast<int>(std::lround(90 + 110 * light)));
+  }
+  return pano;
+}
+
+}  // namespace
+
+TEST_CASE("unwarp + edges find the convention image's floor-wall boundary at its model rows",
+          "[vision][convention]") {
+  const MirrorModel model;
+  const PanoramaUnwarper unwarper(model);
+  const cv::Mat image = cv::imread(kConventionImage, cv::IMREAD_GRAYSCALE);
+  REQUIRE(image.rows == 1024);
+  EdgeDetector detector;
+  EdgeSelectionConfig config;
+  // README of the reference: along +x the boundary is at inner row 79.40, outer row 90.45.
+  for (const auto &[lobe, expected] : {std::pair{Lobe::kInner, 79.40}, std::pair{Lobe::kOuter, 90.45}}) {
+    cv::Mat panorama, texture;
+    unwarper.unwarp(image, lobe, panorama);
+    REQUIRE(panorama.rows == 225);
+    REQUIRE(panorama.cols == 360);
+    EdgeImage edges;
+    detector.detect(panorama, edges);
+    make_texture(panorama, {}, texture);
+    ColumnEdges candidates;
+    const SelectionStats stats = select_nearest_horizontal_edges(edges, texture, config, candidates);
+    CHECK(stats.selected > 300);
+    for (int column : {0, 359}) {  // azimuth 0.5 and 359.5 deg: wall x = 3 m, 1 m below
+      CAPTURE(column, expected);
+      REQUIRE(candidates.column(column).size() == 1);
+      CHECK(candidates.column(column)[0].row_subpx == Approx(expected).margin(0.1));
+    }
+  }
+}
+
+TEST_CASE("Canny thresholds: automatic choice has a floor, fixed ones are used as given", "[vision][canny]") {
+  const cv::Mat pano = step_panorama(100.3);
+  EdgeImage automatic, fixed;
+  EdgeDetector(CannyConfig{}).detect(pano, automatic);
+  CHECK(automatic.high_threshold == Approx(24.0));  // uniform rows: the quantile is ~0
+  CHECK(automatic.low_threshold == Approx(0.4 * 24.0));
+  CHECK(automatic.canny_px >= 360);  // the step, across every column
+  CannyConfig config;
+  config.auto_thresholds = false;
+  config.high_threshold = 5000.0;
+  config.low_threshold = 4000.0;
+  EdgeDetector(config).detect(pano, fixed);
+  CHECK(fixed.high_threshold == 5000.0);
+  CHECK(fixed.canny_px == 0);
+}
+
+TEST_CASE("tiny edge fragments are removed, long edges kept", "[vision][canny]") {
+  cv::Mat pano(225, 360, CV_8UC1, cv::Scalar(100));
+  cv::rectangle(pano, cv::Rect(50, 100, 2, 2), cv::Scalar(220), cv::FILLED);   // a speck
+  cv::rectangle(pano, cv::Rect(0, 150, 360, 75), cv::Scalar(30), cv::FILLED);  // a long step
+  CannyConfig config;
+  config.min_fragment_px = 20;
+  EdgeImage edges;
+  EdgeDetector(config).detect(pano, edges);
+  CHECK(edges.fragment_px_removed > 0);
+  CHECK(cv::countNonZero(edges.edges(cv::Rect(40, 90, 25, 25))) == 0);
+  CHECK(cv::countNonZero(edges.edges.row(149)) + cv::countNonZero(edges.edges.row(150)) >= 300);
+}
+
+TEST_CASE("edge selection: horizontal only, nearest (bottom) first, capped per column",
+          "[vision][selection]") {
+  cv::Mat pano(225, 360, CV_8UC1, cv::Scalar(60));
+  for (int band = 0; band < 5; ++band) {  // horizontal steps at rows 40, 70, ..., 160
+    cv::rectangle(pano, cv::Rect(0, 40 + 30 * band, 180, 15), cv::Scalar(200), cv::FILLED);
+  }
+  cv::rectangle(pano, cv::Rect(270, 0, 90, 225), cv::Scalar(200), cv::FILLED);  // vertical step at column 270
+  EdgeImage edges;
+  EdgeDetector().detect(pano, edges);
+  cv::Mat texture;
+  make_texture(pano, {}, texture);
+  EdgeSelectionConfig config;
+  config.max_edges_per_column = 3;
+  ColumnEdges candidates;
+  select_nearest_horizontal_edges(edges, texture, config, candidates);
+  const auto column = candidates.column(90);
+  REQUIRE(column.size() == 3);
+  // Bottom-up: the lower boundary of the lowest band (row 174.5 between 174 and 175), ...
+  CHECK(column[0].row_subpx == Approx(174.5).margin(0.35));
+  CHECK(column[1].row_subpx == Approx(159.5).margin(0.35));
+  CHECK(column[2].row_subpx == Approx(144.5).margin(0.35));
+  CHECK(column[0].row > column[1].row);
+  for (int c = 265; c < 275; ++c) CHECK(candidates.column(c).empty());  // the vertical edge is dropped
+  CHECK(candidates.column(220).empty());                                // uniform: nothing
+}
+
+TEST_CASE("relative contrast test rejects faint steps", "[vision][selection]") {
+  cv::Mat faint(225, 360, CV_8UC1, cv::Scalar(200));
+  faint.rowRange(0, 100).setTo(cv::Scalar(215));  // (215 - 200) / ~207 = 7% < 15%
+  EdgeImage edges;
+  CannyConfig canny;
+  canny.auto_thresholds = false;
+  canny.high_threshold = 10.0;
+  canny.low_threshold = 5.0;
+  EdgeDetector(canny).detect(faint, edges);
+  cv::Mat texture;
+  make_texture(faint, {}, texture);
+  ColumnEdges candidates;
+  const SelectionStats stats =
+      select_nearest_horizontal_edges(edges, texture, EdgeSelectionConfig{}, candidates);
+  CHECK(stats.runs >= 360);
+  CHECK(stats.low_contrast == stats.runs - stats.not_local_max);
+  CHECK(stats.selected == 0);
+  CHECK(relative_contrast(texture, 100, 5, 3, 1) == Approx(15.0 / (200.0 + 15.0 * 9.0 / 21.0)).epsilon(1e-3));
+}
+
+TEST_CASE("Blackman kernel: 7 taps, symmetric, normalised", "[vision][texture]") {
+  const cv::Mat kernel = blackman_kernel(7);
+  REQUIRE(kernel.total() == 7u);
+  CHECK(cv::sum(kernel)[0] == Approx(1.0));
+  CHECK(kernel.at<float>(0) == Approx(0.0).margin(1e-6));
+  CHECK(kernel.at<float>(1) == Approx(kernel.at<float>(5)));
+  CHECK(kernel.at<float>(3) > kernel.at<float>(2));
+  cv::Mat flat(225, 360, CV_8UC1, cv::Scalar(255)), texture;
+  make_texture(flat, kernel, texture);
+  CHECK(texture.type() == CV_32FC1);
+  CHECK(texture.at<float>(100, 100) == Approx(1.0f));
+}
