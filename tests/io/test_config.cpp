@@ -90,3 +90,24 @@ TEST_CASE("config: unknown keys and wrong types name the key and file:line", "[i
   CHECK_THROWS_WITH(omnislam::io::load_config("/nonexistent/omnislam.yaml"),
                     Catch::Contains("/nonexistent/omnislam.yaml"));
 }
+
+TEST_CASE("config: the slam section, and the bundled thesis preset", "[io][config]") {
+  const fs::path file =
+      write_file("slam.yaml",
+                 "slam:\n  target: previous_scan\n  metric: point_to_point\n  overlap: 0.8\n"
+                 "  max_correction_deg: 5\n  prune_min_age: 0\n");
+  const omnislam::io::Config config = omnislam::io::load_config(file);
+  CHECK(config.slam.target == omnislam::slam::RegistrationTarget::kPreviousScan);
+  CHECK(config.slam.icp.metric == omnislam::slam::IcpMetric::kPointToPoint);
+  CHECK(config.slam.icp.overlap == 0.8);
+  CHECK(config.slam.max_correction_rad == Approx(5.0 * 3.14159265358979 / 180.0));
+  CHECK(config.slam.map.prune_min_age == 0);
+  CHECK_THROWS_WITH(omnislam::io::load_config(write_file("slam-bad.yaml", "slam:\n  overlap: 1.5\n")),
+                    Catch::Contains("slam-bad.yaml:2") && Catch::Contains("overlap"));
+  CHECK_THROWS_WITH(omnislam::io::load_config(write_file("slam-choice.yaml", "slam:\n  target: moon\n")),
+                    Catch::Contains("target"));
+  const omnislam::io::Config thesis =
+      omnislam::io::load_config(OMNISLAM_SOURCE_DIR "/deploy/thesis-2008.yaml");
+  CHECK(thesis.slam.use_srel_test);
+  CHECK(thesis.slam.target == omnislam::slam::RegistrationTarget::kPreviousScan);
+}

@@ -1,6 +1,9 @@
 #include "omnislam/io/config.hpp"
 
+#include <initializer_list>
+#include <numbers>
 #include <string>
+#include <utility>
 
 #include "camera_fields.hpp"
 #include "yaml_fields.hpp"
@@ -100,6 +103,60 @@ void read_stereo(YamlSection &section, stereo::StereoConfig &stereo) {
     section.fail("far_cutoff_m", "must exceed near_cutoff_m");
 }
 
+template <typename Enum>
+void read_choice(YamlSection &section, const char *key, Enum &value,
+                 std::initializer_list<std::pair<const char *, Enum>> choices, const char *message) {
+  std::string text;
+  section.read(key, text);
+  if (text.empty()) return;
+  for (const auto &[name, choice] : choices) {
+    if (text == name) {
+      value = choice;
+      return;
+    }
+  }
+  section.fail(key, message);
+}
+
+void read_slam(YamlSection &section, slam::SlamConfig &slam) {
+  read_choice(
+      section, "target", slam.target,
+      {{"map", slam::RegistrationTarget::kMap}, {"previous_scan", slam::RegistrationTarget::kPreviousScan}},
+      "must be map or previous_scan");
+  read_choice(
+      section, "metric", slam.icp.metric,
+      {{"point_to_line", slam::IcpMetric::kPointToLine}, {"point_to_point", slam::IcpMetric::kPointToPoint}},
+      "must be point_to_line or point_to_point");
+  section.read("overlap", slam.icp.overlap);
+  section.read("initial_search_radius_m", slam.icp.initial_search_radius_m);
+  section.read("max_iterations", slam.icp.max_iterations);
+  section.read("estimate_scale", slam.icp.estimate_scale);
+  section.read("keep_global_minimum", slam.icp.keep_global_minimum);
+  section.read("use_srel_test", slam.use_srel_test);
+  section.read("srel_limit_percent", slam.srel_limit_percent);
+  section.read("srel_relax_percent", slam.srel_relax_percent);
+  section.read("optional_map_correction", slam.optional_map_correction);
+  section.read("max_rms_m", slam.max_rms_m);
+  section.read("min_inlier_share", slam.min_inlier_share);
+  section.read("max_correction_m", slam.max_correction_m);
+  double max_correction_deg = slam.max_correction_rad * 180.0 / std::numbers::pi;
+  section.read("max_correction_deg", max_correction_deg);
+  slam.max_correction_rad = max_correction_deg * std::numbers::pi / 180.0;
+  section.read("min_scan_points", slam.min_scan_points);
+  section.read("fusion_radius_m", slam.map.fusion_radius_m);
+  section.read("noise_radius_m", slam.map.noise_radius_m);
+  section.read("noise_min_neighbors", slam.map.noise_min_neighbors);
+  section.read("prune_every", slam.map.prune_every);
+  section.read("prune_min_hits", slam.map.prune_min_hits);
+  section.read("prune_min_age", slam.map.prune_min_age);
+  if (!(slam.icp.overlap > 0.0 && slam.icp.overlap <= 1.0)) section.fail("overlap", "must be in (0, 1]");
+  if (!(slam.icp.initial_search_radius_m > 0.0)) section.fail("initial_search_radius_m", "must be positive");
+  if (slam.icp.max_iterations < 1) section.fail("max_iterations", "must be at least 1");
+  if (!(slam.min_inlier_share >= 0.0 && slam.min_inlier_share <= 1.0)) {
+    section.fail("min_inlier_share", "must be in [0, 1]");
+  }
+}
+
 }  // namespace
 
 Config load_config(const std::filesystem::path &file) {
@@ -124,6 +181,11 @@ Config load_config(const std::filesystem::path &file) {
     YamlSection stereo(top.node("stereo"), "stereo", name);
     read_stereo(stereo, config.scan.stereo);
     stereo.finish();
+  }
+  if (top.has("slam")) {
+    YamlSection slam(top.node("slam"), "slam", name);
+    read_slam(slam, config.slam);
+    slam.finish();
   }
   top.finish();
   return config;

@@ -20,8 +20,14 @@
 /// stereo:   {min_range_m, max_range_m, disparity_margin_px, occlusion_cost,
 ///            subpixel: none | edge_peak | cost_curve, triangulation: exact | table,
 ///            near_cutoff_m, far_cutoff_m, one_point_per_degree}
+/// slam:     {target: map | previous_scan, metric: point_to_line | point_to_point, overlap,
+///            initial_search_radius_m, max_iterations, estimate_scale, keep_global_minimum,
+///            use_srel_test, srel_limit_percent, srel_relax_percent, optional_map_correction,
+///            max_rms_m, min_inlier_share, max_correction_m, max_correction_deg, min_scan_points,
+///            fusion_radius_m, noise_radius_m, noise_min_neighbors, prune_every, prune_min_hits,
+///            prune_min_age}
 /// ```
-/// The field meanings are documented on the structs (vision_config.hpp, stereo_config.hpp).
+/// The field meanings are documented on the structs (vision_config.hpp, stereo_config.hpp, slam.hpp).
 
 namespace omnislam::io {
 

@@ -1,0 +1,66 @@
+"""End-to-end: `omnislam replay` + `omnislam evaluate` on the bundled sim-room-37 dataset.
+
+Asserts the accuracy the project claims in the README against the thesis's C++ result
+(83 mm worst-case position error on its simulated room, 1 of 37 images not integrated).
+"""
+import json
+import os
+import pathlib
+import subprocess
+
+ROOT = pathlib.Path(__file__).resolve().parents[2]
+DATASET = ROOT / "datasets" / "sim-room-37"
+
+
+def omnislam():
+    return os.environ.get("OMNISLAM_BIN", str(ROOT / "build" / "modules" / "app" / "omnislam"))
+
+
+def run(*args):
+    result = subprocess.run([omnislam(), *map(str, args)], capture_output=True, text=True)
+    assert result.returncode == 0, result.stderr
+    return result.stdout
+
+
+def test_replay_sim_room_37_beats_the_thesis(tmp_path):
+    assert (DATASET / "dataset.yaml").exists(), f"missing bundled dataset {DATASET}"
+    out = tmp_path / "run"
+    print(run("replay", DATASET, "--out", out))
+    print(run("evaluate", out, DATASET))
+    summary = json.loads((out / "summary.json").read_text())
+    evaluation = json.loads((out / "evaluation.json").read_text())
+
+    assert summary["frames"] == 37
+    lines = [l for l in (out / "trajectory.tum").read_text().splitlines() if not l.startswith("#")]
+    assert len(lines) == 37
+    assert summary["skipped"] == 0
+    assert summary["integrated"] >= 36  # the thesis: 36 of 37
+    ate, odometry = evaluation["ate"], evaluation["odometry_ate"]
+    assert ate["max_m"] < 0.083  # the thesis's C++ result
+    assert ate["max_m"] < 0.5 * odometry["max_m"]
+    assert evaluation["map"]["median_distance_m"] <= 0.05
+    assert evaluation["map"]["completeness"] >= 0.70
+    for name in ("map.ply", "map.csv", "profile.csv", "autolocalizacao.txt", "vetores.txt", "odometriaxy.txt",
+                 "timelog.txt", "mapa1.txt"):
+        assert (out / name).stat().st_size > 0, name
+    for stage in ("unwarp", "canny", "edges", "match", "triangulation", "slam"):
+        assert summary["stage_ms"][stage]["p50"] > 0.0
+
+
+def test_replay_with_thesis_noise_on_exact_odometry(tmp_path):
+    out = tmp_path / "run"
+    run("replay", DATASET, "--out", out, "--odometry-noise", "thesis", "--seed", "7")
+    odometry = (out / "odometriaxy.txt").read_text().splitlines()
+    again = tmp_path / "again"
+    run("replay", DATASET, "--out", again, "--odometry-noise", "thesis", "--seed", "7")
+    assert (again / "odometriaxy.txt").read_text().splitlines() == odometry
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["ate"]["max_m"] < 0.083
+    assert summary["ate"]["max_m"] < 0.5 * summary["odometry_ate"]["max_m"]
+
+
+def test_replay_names_a_missing_dataset(tmp_path):
+    result = subprocess.run([omnislam(), "replay", str(tmp_path / "nope"), "--out", str(tmp_path / "o")],
+                            capture_output=True, text=True)
+    assert result.returncode != 0
+    assert "nope" in result.stderr
