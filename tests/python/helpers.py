@@ -5,6 +5,8 @@ import csv
 import math
 from pathlib import Path
 
+import numpy as np
+
 from omnislam_render.geometry import between, read_tum
 
 TRAJECTORIES = Path(__file__).resolve().parents[2] / "scripts" / "omnislam_render" / "data" / "trajectories.csv"
@@ -33,3 +35,59 @@ def steps(traj):
 
 def angle_diff(a: float, b: float) -> float:
     return math.atan2(math.sin(a - b), math.cos(a - b))
+
+
+def first_hits(segments: np.ndarray, x0: float, y0: float, directions: np.ndarray):
+    """For plan rays from (x0, y0) along unit `directions` (N, 2): distance to and
+    index of the first floor-plan segment hit (inf, -1 when none)."""
+    p1, p2 = segments[:, :2], segments[:, 2:]
+    e = p2 - p1                                        # (S, 2)
+    d = directions[:, None, :]                         # (N, 1, 2)
+    w = p1[None, :, :] - np.array([x0, y0])            # (1, S, 2)
+    det = -d[..., 0] * e[None, :, 1] + d[..., 1] * e[None, :, 0]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        t = (-w[..., 0] * e[None, :, 1] + w[..., 1] * e[None, :, 0]) / det
+        s = (d[..., 0] * w[..., 1] - d[..., 1] * w[..., 0]) / det
+    ok = (np.abs(det) > 1e-12) & (t > 0) & (s >= -1e-9) & (s <= 1 + 1e-9)
+    t = np.where(ok, t, np.inf)
+    idx = np.argmin(t, axis=1)
+    dist = t[np.arange(len(t)), idx]
+    return dist, np.where(np.isfinite(dist), idx, -1)
+
+
+def floor_wall_edge_errors(img: np.ndarray, segments: np.ndarray, n_walls: int, pose, camera_height_mm: float):
+    """Image-radius error (px) of the floor-wall boundary, per lobe, measured along
+    azimuths whose first plan hit (and that of +-1.5 deg) is a wall.  The edge is the
+    half-level crossing of the (linearised) brightness along the radial line."""
+    from omnislam_render import mirror as M
+
+    gray = ((img[..., :3].astype(float) / 255.0) ** 2.2).mean(axis=2)
+    x0, y0, yaw = pose
+    az = np.radians(np.arange(0.5, 360.0, 1.0))
+    hits = [first_hits(segments, x0, y0, np.stack([np.cos(az + yaw + o), np.sin(az + yaw + o)], axis=1))
+            for o in (0.0, math.radians(-1.5), math.radians(1.5))]
+    errors = {"inner": [], "outer": []}
+    for i, a in enumerate(az):
+        k = hits[0][1][i]
+        if not (0 <= k < n_walls and hits[1][1][i] == k and hits[2][1][i] == k):
+            continue
+        for lobe, lo, hi in ((M.INNER, M.R_CENTRAL_PX, M.R_SPLIT_PX), (M.OUTER, M.R_SPLIT_PX, M.R_RIM_PX)):
+            pred = M.rho_px(lobe, hits[0][0][i] * 1000.0, -camera_height_mm)
+            if not lo + 8 < pred < hi - 8:
+                continue
+            radii = np.arange(pred - 4, pred + 4, 0.02)
+            u, v = M.CENTER_PX + radii * math.cos(a), M.CENTER_PX + radii * math.sin(a)
+            u0, v0 = np.floor(u).astype(int), np.floor(v).astype(int)
+            fu, fv = u - u0, v - v0
+            prof = (gray[v0, u0] * (1 - fu) * (1 - fv) + gray[v0, u0 + 1] * fu * (1 - fv)
+                    + gray[v0 + 1, u0] * (1 - fu) * fv + gray[v0 + 1, u0 + 1] * fu * fv)
+            near, far = prof[:20].mean(), prof[-20:].mean()
+            if abs(far - near) < 0.05:
+                continue
+            cross = np.nonzero(np.diff(np.sign(prof - (near + far) / 2)))[0]
+            if len(cross) != 1:
+                continue
+            j = cross[0]
+            r = radii[j] + ((near + far) / 2 - prof[j]) / (prof[j + 1] - prof[j]) * 0.02
+            errors[lobe.name].append(r - pred)
+    return {k: np.array(v) for k, v in errors.items()}

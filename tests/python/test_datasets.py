@@ -13,7 +13,7 @@ import pytest
 import yaml
 
 from conftest import DATASET_NAMES, REPO, SCRIPTS
-from helpers import angle_diff, poses, steps, table_mm, times
+from helpers import angle_diff, floor_wall_edge_errors, poses, steps, table_mm, times
 
 from omnislam_render import convention, datasets, geocheck, mirror, odometry
 from omnislam_render.pngio import read_png
@@ -269,3 +269,20 @@ def test_identical_poses_reuse_images(tmp_path):
     assert stats["rendered"] == 0 and stats["reused"] == 3
     for i in (1, 2, 3):
         assert (two / "images" / f"{i:06d}.png").read_bytes() == b"frame %d" % i
+
+
+def test_floor_wall_edges_match_mirror_model(metadata_dir, tmp_path):
+    """A turned pose of sim-room-turning: the floor-wall boundary seen in both lobes
+    lies where mirror.md projects the floor-plan walls (map frame, ground truth)."""
+    name, frame = "sim-room-turning", 10
+    spec = datasets.DATASETS[name]
+    datasets.render_images(spec, tmp_path, [spec.world_poses()[frame - 1]], log=lambda *_: None)
+    img = read_png(tmp_path / "images" / "000001.png")
+    segments = np.loadtxt(metadata_dir / name / "floorplan.csv", delimiter=",", skiprows=1)
+    pose = poses(metadata_dir / name / "groundtruth.tum")[frame - 1]
+    errors = floor_wall_edge_errors(img, segments, 4, pose, 1000.0)
+    for lobe in ("inner", "outer"):
+        assert len(errors[lobe]) >= 60
+        assert abs(np.median(errors[lobe])) < 0.1
+        assert np.median(np.abs(errors[lobe])) < 0.2
+        assert np.percentile(np.abs(errors[lobe]), 95) < 0.5

@@ -1,0 +1,248 @@
+"""Dataset definitions and writing (architecture.md, "Dataset format")."""
+from __future__ import annotations
+
+import csv
+import hashlib
+import math
+import os
+import re
+import shutil
+import tempfile
+import time
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Callable, Sequence
+
+from . import mirror as M
+from . import odometry as odo
+from . import pov
+from .geometry import Pose, compose, inverse, relative_to_first, write_tum, read_tum
+from .rooms import l_room, sim_room
+from .scene import Room, frame_scene
+
+TRAJECTORIES_CSV = Path(__file__).resolve().parent / "data" / "trajectories.csv"
+RATE_HZ = 10
+CAMERA_HEIGHT_M = 1.0
+NOISE_SEED = 1
+ANTIALIAS = "+A0.1 +AM1 +R3"   # adaptive 3x3 supersampling of contrasted pixels, no jitter
+RENDERER_VERSION = "2"          # part of the render key: bump when the image output changes
+
+
+def table_points(table: str) -> list[tuple[float, float]]:
+    """(x, y) in metres of the poses of one table of trajectories.csv, in order."""
+    rows = []
+    with open(TRAJECTORIES_CSV) as fh:
+        for row in csv.reader(ln for ln in fh if not ln.startswith("#")):
+            if row and row[0] == table:
+                rows.append((int(row[1]), float(row[2]) / 1000.0, float(row[3]) / 1000.0))
+    rows.sort()
+    return [(x, y) for _, x, y in rows]
+
+
+def facing_travel(points: Sequence[tuple[float, float]], spread: int = 3) -> list[Pose]:
+    """Poses that face the direction of travel; each heading change is spread over
+    `spread` poses centred on the corner (linear in yaw, shortest turn)."""
+    n = len(points)
+    step_dir = [math.atan2(points[i + 1][1] - points[i][1], points[i + 1][0] - points[i][0])
+                for i in range(n - 1)]
+    heading = [step_dir[min(i, n - 2)] for i in range(n)]
+    # unwrap so that each change is the shortest turn
+    for i in range(1, n):
+        heading[i] = heading[i - 1] + math.atan2(math.sin(heading[i] - heading[i - 1]),
+                                                 math.cos(heading[i] - heading[i - 1]))
+    smooth = list(heading)
+    for k in range(1, n - 1):
+        delta = heading[k] - heading[k - 1]
+        if abs(delta) < 1e-12:
+            continue
+        half = spread // 2
+        for j in range(-half, spread - half):
+            idx = k + j
+            if 0 <= idx < n:
+                smooth[idx] = heading[k - 1] + delta * (j + half + 1) / (spread + 1)
+    return [(x, y, math.atan2(math.sin(h), math.cos(h))) for (x, y), h in zip(points, smooth)]
+
+
+@dataclass
+class DatasetSpec:
+    name: str
+    room: Callable[[], Room]
+    world_poses: Callable[[], list[Pose]]   # robot poses in the room frame
+    constant_heading: bool
+    description: str
+
+
+def _still(points) -> list[Pose]:
+    return [(x, y, 0.0) for x, y in points]
+
+
+def _l_laps(laps: int) -> list[Pose]:
+    pts = table_points("3.3")
+    return _still(pts * laps + pts[:1])
+
+
+DATASETS: dict[str, DatasetSpec] = {
+    "sim-room-10": DatasetSpec("sim-room-10", sim_room, lambda: _still(table_points("3.1")), True,
+                               "thesis simulated room, table 3.1 poses, constant heading"),
+    "sim-room-37": DatasetSpec("sim-room-37", sim_room, lambda: _still(table_points("3.2")), True,
+                               "thesis simulated room, table 3.2 poses, constant heading"),
+    "sim-room-turning": DatasetSpec("sim-room-turning", sim_room,
+                                    lambda: facing_travel(table_points("3.2")), False,
+                                    "table 3.2 path, robot facing its direction of travel"),
+    "l-room-1lap": DatasetSpec("l-room-1lap", l_room, lambda: _l_laps(1), True,
+                               "L-shaped room, table 3.3 poses, one lap back to pose 1"),
+    "l-room-2laps": DatasetSpec("l-room-2laps", l_room, lambda: _l_laps(2), True,
+                                "L-shaped room, table 3.3 poses, two laps back to pose 1"),
+}
+
+
+def render_key(room: Room) -> str:
+    text = "|".join([RENDERER_VERSION, room.pov_body(), pov.camera_block(), pov.mirror_block(), ANTIALIAS,
+                     repr(CAMERA_HEIGHT_M)])
+    return hashlib.sha256(text.encode()).hexdigest()[:16]
+
+
+def _fmt(x: float) -> str:
+    return repr(float(x))
+
+
+def dataset_yaml(spec: DatasetSpec, frames: int, origin: Pose, key: str) -> str:
+    return (
+        f"# omnislam dataset rendered by scripts/render-dataset (POV-Ray): {spec.description}\n"
+        f"# renderer: room {spec.room().name}, render key {key}, "
+        f"map origin in room frame: x={_fmt(origin[0])} y={_fmt(origin[1])} yaw={_fmt(origin[2])}\n"
+        f"name: {spec.name}\n"
+        f"camera: {{width: {M.IMAGE_PX}, height: {M.IMAGE_PX}, center_px: [{M.CENTER_PX}, {M.CENTER_PX}], "
+        f"focal_mm: {M.FOCAL_MM}, pixel_pitch_mm: {_fmt(M.PIXEL_MM)}}}\n"
+        "mirror: thesis-2008          # mirror.md, derived constants\n"
+        f"camera_height_m: {CAMERA_HEIGHT_M}         # height of the camera pinhole F0 above the floor\n"
+        f"frames: {frames}\n"
+        f"rate_hz: {RATE_HZ}\n"
+        "images: images/%06d.png\n"
+        "groundtruth: groundtruth.tum\n"
+        "odometry: odometry.tum\n"
+        "odometry_exact: odometry_exact.tum\n"
+        f"odometry_noise: {{model: thesis, seed: {NOISE_SEED}}}\n"
+        "floorplan: floorplan.csv\n"
+    )
+
+
+def write_floorplan(path: Path, room: Room, origin: Pose) -> None:
+    to_map = inverse(origin)
+    lines = ["x1,y1,x2,y2"]
+    for x1, y1, x2, y2 in room.floorplan():
+        a = compose(to_map, (x1, y1, 0.0))
+        b = compose(to_map, (x2, y2, 0.0))
+        lines.append(f"{a[0]:.9f},{a[1]:.9f},{b[0]:.9f},{b[1]:.9f}")
+    path.write_text("\n".join(lines) + "\n")
+
+
+def write_metadata(spec: DatasetSpec, out: Path, frames: int | None = None) -> list[Pose]:
+    """Everything but the images; returns the world poses of the frames written."""
+    world = spec.world_poses()
+    if frames is not None:
+        world = world[:frames]
+    room = spec.room()
+    out.mkdir(parents=True, exist_ok=True)
+    origin = world[0]
+    gt = relative_to_first(world)
+    write_tum(out / "groundtruth.tum", gt, RATE_HZ,
+              f"{spec.name} ground truth: base_link in map (map = pose of frame 1)")
+    write_tum(out / "odometry_exact.tum", odo.odometry(gt, None), RATE_HZ,
+              f"{spec.name} exact odometry (ground-truth increments composed)")
+    noisy = odo.odometry(gt, NOISE_SEED)
+    write_tum(out / "odometry.tum", noisy, RATE_HZ,
+              f"{spec.name} odometry, noise model thesis, seed {NOISE_SEED}")
+    if spec.constant_heading:
+        odo.write_thesis_odometry(out / "odometry.txt", noisy)
+    elif (out / "odometry.txt").exists():
+        (out / "odometry.txt").unlink()
+    write_floorplan(out / "floorplan.csv", room, origin)
+    (out / "dataset.yaml").write_text(dataset_yaml(spec, len(world), origin, render_key(room)))
+    return world
+
+
+def _pose_key(p: Pose) -> tuple:
+    return tuple(round(v, 9) for v in p)
+
+
+def _reusable_images(out: Path, key: str) -> dict[tuple, Path]:
+    """Images of sibling datasets rendered with the same render key, by world pose."""
+    found: dict[tuple, Path] = {}
+    parent = out.resolve().parent
+    if not parent.is_dir():
+        return found
+    for yaml_file in sorted(parent.glob("*/dataset.yaml")):
+        other = yaml_file.parent
+        if other.resolve() == out.resolve():
+            continue
+        m = re.search(r"render key (\w+), map origin in room frame: x=(\S+) y=(\S+) yaw=(\S+)",
+                      yaml_file.read_text())
+        if not m or m.group(1) != key:
+            continue
+        origin = (float(m.group(2)), float(m.group(3)), float(m.group(4)))
+        try:
+            gt = read_tum(other / "groundtruth.tum")
+        except (OSError, ValueError):
+            continue
+        for i, (_, pose) in enumerate(gt, start=1):
+            img = other / "images" / f"{i:06d}.png"
+            if img.is_file():
+                found.setdefault(_pose_key(compose(origin, pose)), img)
+    return found
+
+
+def _link_or_copy(src: Path, dst: Path) -> None:
+    tmp = dst.with_suffix(".tmp.png")
+    if tmp.exists():
+        tmp.unlink()
+    try:
+        os.link(src, tmp)
+    except OSError:
+        shutil.copyfile(src, tmp)
+    os.replace(tmp, dst)
+
+
+def render_images(spec: DatasetSpec, out: Path, world: Sequence[Pose], threads: int = 2,
+                  log=print) -> dict:
+    room = spec.room()
+    key = render_key(room)
+    images = out / "images"
+    images.mkdir(parents=True, exist_ok=True)
+    for stale in images.glob("*.png"):
+        if not re.fullmatch(r"\d{6}", stale.stem) or int(stale.stem) > len(world):
+            stale.unlink()
+    reuse = _reusable_images(out, key)
+    done: dict[tuple, Path] = {}
+    camera, mirror = pov.camera_block(), pov.mirror_block()
+    times, reused = [], 0
+    with tempfile.TemporaryDirectory(prefix=f"omnislam-{spec.name}-") as tmp:
+        for i, pose in enumerate(world, start=1):
+            dst = images / f"{i:06d}.png"
+            pk = _pose_key(pose)
+            src = done.get(pk) or reuse.get(pk)
+            if src is not None:
+                _link_or_copy(src, dst)
+                reused += 1
+            else:
+                pov_file = Path(tmp) / f"{i:06d}.pov"
+                pov_file.write_text(frame_scene(room, pose, CAMERA_HEIGHT_M, camera, mirror))
+                png_tmp = Path(tmp) / f"{i:06d}.png"
+                times.append(pov.render(pov_file, png_tmp, threads=threads, antialias=ANTIALIAS))
+                shutil.move(str(png_tmp), dst)
+                log(f"{spec.name}: frame {i}/{len(world)} rendered in {times[-1]:.2f} s")
+            done.setdefault(pk, dst)
+    return {"rendered": len(times), "reused": reused,
+            "seconds_per_frame": (sum(times) / len(times)) if times else 0.0}
+
+
+def build(name: str, out: Path, frames: int | None = None, images: bool = True,
+          threads: int = 2, log=print) -> dict:
+    spec = DATASETS[name]
+    t0 = time.monotonic()
+    world = write_metadata(spec, out, frames)
+    stats = {"frames": len(world)}
+    if images:
+        stats.update(render_images(spec, out, world, threads=threads, log=log))
+    stats["seconds"] = time.monotonic() - t0
+    return stats
