@@ -79,3 +79,31 @@ TEST_CASE("dataset.yaml, groundtruth.tum and floorplan.csv", "[io][dataset]") {
   CHECK_THROWS_WITH(omnislam::io::read_dataset_info(dir),
                     Catch::Contains("dataset.yaml:1:") && Catch::Contains("'frames'"));
 }
+
+TEST_CASE("thesis odometry.txt: cumulative translations, errors name file:line", "[io][odometry]") {
+  const fs::path dir = scratch("thesis-odometry");
+  { std::ofstream(dir / "odometry.txt") << "3\n0.0 0.0\n250.0 90.0\n500 180\n"; }
+  const auto poses = omnislam::io::read_thesis_odometry(dir / "odometry.txt");
+  REQUIRE(poses.size() == 3);
+  CHECK(poses[1].x_m == Approx(0.0).margin(1e-12));
+  CHECK(poses[1].y_m == Approx(0.25));
+  CHECK(poses[2].x_m == Approx(-0.5));
+  CHECK(poses[2].y_m == Approx(0.25));
+  { std::ofstream(dir / "bad.txt") << "2\n0.0 0.0\n250.0 north\n"; }
+  CHECK_THROWS_WITH(omnislam::io::read_thesis_odometry(dir / "bad.txt"), Catch::Contains("bad.txt:3"));
+  { std::ofstream(dir / "count.txt") << "5\n0.0 0.0\n"; }
+  CHECK_THROWS_WITH(omnislam::io::read_thesis_odometry(dir / "count.txt"), Catch::Contains("announces 5"));
+  { std::ofstream(dir / "nan.txt") << "2\n0.0 0.0\nnan 0\n"; }
+  CHECK_THROWS_WITH(omnislam::io::read_thesis_odometry(dir / "nan.txt"), Catch::Contains("nan.txt:3"));
+}
+
+TEST_CASE("thesis odometry.txt of a rendered dataset matches its odometry.tum", "[io][odometry]") {
+  const fs::path dataset = fs::path(OMNISLAM_SOURCE_DIR) / "datasets" / "sim-room-37";
+  const auto thesis = omnislam::io::read_thesis_odometry(dataset / "odometry.txt");
+  const auto tum = omnislam::io::read_tum_file(dataset / "odometry.tum");
+  REQUIRE(thesis.size() == tum.size());
+  for (std::size_t i = 0; i < tum.size(); ++i) {
+    CHECK(thesis[i].x_m == Approx(tum[i].x_m - tum[0].x_m).margin(1e-5));
+    CHECK(thesis[i].y_m == Approx(tum[i].y_m - tum[0].y_m).margin(1e-5));
+  }
+}

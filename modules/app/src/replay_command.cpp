@@ -23,6 +23,7 @@ struct ReplayOptions {
   std::string dataset;
   std::string config_file;
   std::string out_dir;
+  std::string odometry_file;
   std::string odometry_noise;
   std::uint64_t seed = 1;
 };
@@ -42,8 +43,14 @@ class StageClock {
   Clock::time_point last_;
 };
 
-// Odometry as the robot reports it, or the thesis noise model applied to the exact one.
+// Odometry as the robot reports it (the dataset's, or a given TUM or thesis-format file),
+// or the thesis noise model applied to the exact one.
 std::vector<Eigen::Isometry2d> load_odometry(const io::DatasetInfo &info, const ReplayOptions &options) {
+  if (!options.odometry_file.empty()) {
+    const std::filesystem::path file = options.odometry_file;
+    return to_isometries(file.extension() == ".txt" ? io::read_thesis_odometry(file)
+                                                    : io::read_tum_file(file));
+  }
   if (options.odometry_noise.empty()) return to_isometries(io::read_tum_file(info.odometry));
   return slam::apply_thesis_odometry_noise(to_isometries(io::read_tum_file(info.odometry_exact)),
                                            options.seed);
@@ -128,9 +135,13 @@ void add_replay_command(CLI::App &app) {
   command->add_option("dataset", options->dataset, "dataset directory (with dataset.yaml)")->required();
   command->add_option("--config", options->config_file, "YAML configuration");
   command->add_option("--out", options->out_dir, "output directory")->required();
+  auto *odometry =
+      command->add_option("--odometry", options->odometry_file,
+                          "odometry file instead of the dataset's: TUM, or the thesis format (.txt)");
   command
       ->add_option("--odometry-noise", options->odometry_noise, "apply a noise model to odometry_exact.tum")
-      ->check(CLI::IsMember({"thesis"}));
+      ->check(CLI::IsMember({"thesis"}))
+      ->excludes(odometry);
   command->add_option("--seed", options->seed, "seed of the odometry noise");
   command->callback([options] { run_replay(*options); });
 }

@@ -21,6 +21,13 @@ struct StampedPose {
 /// naming file:line on a malformed line or an unreadable file.
 [[nodiscard]] std::vector<StampedPose> read_tum_file(const std::filesystem::path &file);
 
+/// Reads odometry in the thesis's format (annex A; architecture.md odometry.txt): line 1 is
+/// the frame count, then per frame "distance_mm angle_deg" of the translation since the
+/// previous frame (angle in the map frame from +x towards +y; heading constant). Returns
+/// one pose per frame in metres, yaw 0, t = frame index. Throws naming file:line on a
+/// malformed or non-finite value or a count that does not match the lines.
+[[nodiscard]] std::vector<StampedPose> read_thesis_odometry(const std::filesystem::path &file);
+
 /// A floor-plan segment in the map frame, metres.
 struct FloorplanSegment {
   double x1_m = 0.0, y1_m = 0.0, x2_m = 0.0, y2_m = 0.0;
