@@ -34,6 +34,17 @@ inline std::vector<Segment> l_room() {
   return walls;
 }
 
+/// A 4 x 4 m room with one box: every wall stays within scan range of a path inside it.
+inline std::vector<Segment> square_room() {
+  std::vector<Segment> walls = {
+      {{-1, -1}, {3, -1}}, {{3, -1}, {3, 3}}, {{3, 3}, {-1, 3}}, {{-1, 3}, {-1, -1}}};
+  walls.push_back({{0.8, 0.8}, {1.2, 0.8}});
+  walls.push_back({{1.2, 0.8}, {1.2, 1.2}});
+  walls.push_back({{1.2, 1.2}, {0.8, 1.2}});
+  walls.push_back({{0.8, 1.2}, {0.8, 0.8}});
+  return walls;
+}
+
 /// Distance along the ray from `origin` in direction `angle` to the nearest segment.
 inline std::optional<double> cast(const std::vector<Segment> &walls, const Eigen::Vector2d &origin,
                                   double angle) {

@@ -143,6 +143,11 @@ void read_slam(YamlSection &section, slam::SlamConfig &slam) {
   section.read("max_correction_deg", max_correction_deg);
   slam.max_correction_rad = max_correction_deg * std::numbers::pi / 180.0;
   section.read("min_scan_points", slam.min_scan_points);
+  section.read("use_odometry", slam.use_odometry);
+  section.read("no_odometry_min_srel_percent", slam.no_odometry_min_srel_percent);
+  double no_odometry_max_rotation_deg = slam.no_odometry_max_rotation_rad * 180.0 / std::numbers::pi;
+  section.read("no_odometry_max_rotation_deg", no_odometry_max_rotation_deg);
+  slam.no_odometry_max_rotation_rad = no_odometry_max_rotation_deg * std::numbers::pi / 180.0;
   section.read("fusion_radius_m", slam.map.fusion_radius_m);
   section.read("noise_radius_m", slam.map.noise_radius_m);
   section.read("noise_min_neighbors", slam.map.noise_min_neighbors);

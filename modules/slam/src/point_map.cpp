@@ -1,8 +1,14 @@
 #include "omnislam/slam/point_map.hpp"
 
 #include <algorithm>
+#include <utility>
 
 namespace omnislam::slam {
+
+PointMap::PointMap(PointMapConfig config, std::vector<MapPoint> points, int integrations)
+    : config_(config), points_(std::move(points)), integrations_(integrations) {
+  rebuild_index();
+}
 
 void PointMap::integrate(const Points2 &points_map) {
   ++integrations_;

@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <numbers>
+#include <utility>
 
 namespace omnislam::slam {
 namespace {
@@ -38,46 +39,85 @@ bool Slam::accept(const TrimmedIcpResult &registration, const Eigen::Isometry2d 
          std::abs(yaw_of(correction)) <= config_.max_correction_rad;
 }
 
+bool Slam::accept_without_odometry(const TrimmedIcpResult &registration, const Eigen::Isometry2d &predicted,
+                                   const Eigen::Isometry2d &estimate) const {
+  if (!registration.valid || registration.srel_percent <= config_.no_odometry_min_srel_percent) return false;
+  if (std::sqrt(registration.final_error_m2) > config_.max_rms_m) return false;
+  if (registration.inlier_share < config_.min_inlier_share) return false;
+  const Eigen::Isometry2d correction = predicted.inverse() * estimate;
+  return correction.translation().norm() <= config_.icp.initial_search_radius_m &&
+         std::abs(yaw_of(correction)) <= config_.no_odometry_max_rotation_rad;
+}
+
 FrameEstimate Slam::register_scan(const Points2 &scan_base, const Eigen::Isometry2d &predicted) {
   const double srel_limit = config_.srel_limit_percent + relaxation_percent_;
+  auto accepted = [&](const TrimmedIcpResult &r, const Eigen::Isometry2d &pose) {
+    return config_.use_odometry ? accept(r, predicted, pose, srel_limit)
+                                : accept_without_odometry(r, predicted, pose);
+  };
   FrameEstimate estimate;
   estimate.T_map_base = predicted;
 
   auto try_forward = [&](const NearestNeighbors &model, Attempt attempt) {
     const TrimmedIcpResult r = register_trimmed_icp(model, scan_base, predicted, config_.icp);
     estimate.registration = r;
-    if (!accept(r, predicted, r.T_model_sample, srel_limit)) return false;
+    if (!accepted(r, r.T_model_sample)) return false;
     estimate = {r.T_model_sample, true, attempt, r, r.covariance};
+    return true;
+  };
+  // Reverse: an earlier scan registered onto this one, in this scan's frame.
+  const NearestNeighbors current(scan_base);
+  auto try_reverse = [&](const Points2 &earlier_map, Attempt attempt) {
+    const TrimmedIcpResult r = register_trimmed_icp(current, earlier_map, predicted.inverse(), config_.icp);
+    estimate.registration = r;
+    const Eigen::Isometry2d pose = r.T_model_sample.inverse();
+    if (!accepted(r, pose)) return false;
+    estimate = {pose, true, attempt, r, r.covariance};
     return true;
   };
 
   if (config_.target == RegistrationTarget::kMap && try_forward(map_.index(), Attempt::kMap)) return estimate;
-
-  const NearestNeighbors previous(previous_scan_map_);
-  if (try_forward(previous, Attempt::kPreviousForward)) return estimate;
-
-  // Reverse: the previous scan registered onto this one, in this scan's frame.
-  const NearestNeighbors current(scan_base);
-  const TrimmedIcpResult reverse =
-      register_trimmed_icp(current, previous_scan_map_, predicted.inverse(), config_.icp);
-  estimate.registration = reverse;
-  const Eigen::Isometry2d reverse_pose = reverse.T_model_sample.inverse();
-  if (accept(reverse, predicted, reverse_pose, srel_limit)) {
-    estimate = {reverse_pose, true, Attempt::kPreviousReverse, reverse, reverse.covariance};
+  // The thesis registers against the previous scan (with odometry), or against each of
+  // the last three (without), forward then reverse.
+  const std::size_t scans = config_.use_odometry ? 1 : recent_scans_map_.size();
+  for (std::size_t i = 0; i < scans && i < recent_scans_map_.size(); ++i) {
+    const Points2 &earlier = recent_scans_map_[i];
+    if (try_forward(NearestNeighbors(earlier), i == 0 ? Attempt::kPreviousForward : Attempt::kOlderForward) ||
+        try_reverse(earlier, i == 0 ? Attempt::kPreviousReverse : Attempt::kOlderReverse)) {
+      return estimate;
+    }
   }
   return estimate;
 }
 
+void Slam::resume(std::vector<MapPoint> points, int integrations, const Eigen::Isometry2d &T_map_base,
+                  const Eigen::Matrix3d &covariance) {
+  map_ = PointMap(config_.map, std::move(points), integrations);
+  previous_T_odom_base_.reset();
+  previous_ = {T_map_base, true, Attempt::kNone, {}, covariance};
+  // Until a scan has been seen, the whole map stands in for the previous local map.
+  recent_scans_map_.assign(1, map_.index().points());
+  relaxation_percent_ = 0.0;
+  previous_failed_ = false;
+}
+
+FrameEstimate Slam::seed_map(const Points2 &scan_base) {
+  // A new map starts at the current pose: the identity on a fresh start, so the first
+  // frame defines the map frame (REP-105 map = first pose).
+  previous_ = {previous_.T_map_base, true, Attempt::kFirstFrame, {}, previous_.covariance};
+  recent_scans_map_.assign(1, transformed(scan_base, previous_.T_map_base));
+  map_.integrate(recent_scans_map_.front());
+  return previous_;
+}
+
 FrameEstimate Slam::process(const Points2 &scan_base, const Eigen::Isometry2d &T_odom_base) {
+  Eigen::Isometry2d step = Eigen::Isometry2d::Identity();
   if (!previous_T_odom_base_) {
-    // The first frame defines the map frame (REP-105 map = first pose).
     previous_T_odom_base_ = T_odom_base;
-    previous_ = {Eigen::Isometry2d::Identity(), true, Attempt::kFirstFrame, {}, Eigen::Matrix3d::Zero()};
-    previous_scan_map_ = scan_base;
-    map_.integrate(scan_base);
-    return previous_;
+    if (map_.empty() && !config_.localization_only) return seed_map(scan_base);
+  } else if (config_.use_odometry) {
+    step = previous_T_odom_base_->inverse() * T_odom_base;
   }
-  const Eigen::Isometry2d step = previous_T_odom_base_->inverse() * T_odom_base;
   previous_T_odom_base_ = T_odom_base;
   const Eigen::Isometry2d predicted = previous_.T_map_base * step;
 
@@ -96,7 +136,7 @@ FrameEstimate Slam::process(const Points2 &scan_base, const Eigen::Isometry2d &T
 
   if (estimate.integrated) {
     relaxation_percent_ = 0.0;
-    map_.integrate(transformed(scan_base, estimate.T_map_base));
+    if (!config_.localization_only) map_.integrate(transformed(scan_base, estimate.T_map_base));
   } else {
     relaxation_percent_ += config_.srel_relax_percent;
     const Eigen::Matrix2d R = previous_.T_map_base.linear();
@@ -106,7 +146,8 @@ FrameEstimate Slam::process(const Points2 &scan_base, const Eigen::Isometry2d &T
   }
   previous_failed_ = !estimate.integrated;
   // Thesis fig. 5.3: second_last = last every iteration, integrated or not.
-  previous_scan_map_ = transformed(scan_base, estimate.T_map_base);
+  recent_scans_map_.push_front(transformed(scan_base, estimate.T_map_base));
+  if (recent_scans_map_.size() > 3) recent_scans_map_.pop_back();
   previous_ = estimate;
   return estimate;
 }

@@ -31,6 +31,10 @@ class PointMap {
  public:
   explicit PointMap(PointMapConfig config = {}) : config_(config) {}
 
+  /// A map restored from saved points (e.g. a snapshot): `integrations` is the integration
+  /// count it had, so the age of each point (its first_seen) keeps its meaning.
+  PointMap(PointMapConfig config, std::vector<MapPoint> points, int integrations);
+
   /// Fuses `points_map` (already in the map frame) into the map, filters noise and, every
   /// prune_every integrations, drops rarely seen points; then rebuilds the search index.
   void integrate(const Points2 &points_map);

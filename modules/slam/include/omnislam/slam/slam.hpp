@@ -1,6 +1,7 @@
 #pragma once
 
 #include <Eigen/Geometry>
+#include <deque>
 #include <optional>
 
 #include "omnislam/slam/nearest_neighbors.hpp"
@@ -39,14 +40,32 @@ struct SlamConfig {
   double max_correction_m = 0.3;
   double max_correction_rad = 0.1745;
   int min_scan_points = 20;
+  /// false: the thesis's SLAM without odometry (sec. 5.2): no motion prediction; the scan
+  /// is registered against the map (with kMap) and the last three scans, forward then
+  /// reverse, and accepted when Srel exceeds no_odometry_min_srel_percent and the rotation
+  /// stays within no_odometry_max_rotation_rad (plus the absolute checks).
+  bool use_odometry = true;
+  double no_odometry_min_srel_percent = 50.0;
+  double no_odometry_max_rotation_rad = 0.0873;
+  /// Localization only: frames are registered against the (restored) map as usual, but
+  /// nothing is ever integrated, so the map stays exactly as it was loaded.
+  bool localization_only = false;
 };
 
 /// Which registration was accepted for a frame.
-enum class Attempt { kNone, kFirstFrame, kMap, kPreviousForward, kPreviousReverse };
+enum class Attempt {
+  kNone,
+  kFirstFrame,
+  kMap,
+  kPreviousForward,
+  kPreviousReverse,
+  kOlderForward,
+  kOlderReverse
+};
 
 struct FrameEstimate {
   Eigen::Isometry2d T_map_base = Eigen::Isometry2d::Identity();
-  bool integrated = false;
+  bool integrated = false;  ///< a registration was accepted (and, unless localization_only, integrated)
   Attempt attempt = Attempt::kNone;
   TrimmedIcpResult registration;                         ///< the accepted one, or the last tried
   Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();  ///< (x, y, yaw) in the map frame
@@ -57,8 +76,16 @@ class Slam {
   explicit Slam(SlamConfig config = {}) : config_(config), map_(config.map) {}
 
   /// Processes one local scan (base_link points, metres) with the odometry pose of the
-  /// same frame (any fixed odom frame). The first frame defines the map frame.
+  /// same frame (any fixed odom frame). The first frame defines the map frame, unless the
+  /// state was resumed: then the first frame is predicted at the resumed pose.
   [[nodiscard]] FrameEstimate process(const Points2 &scan_base, const Eigen::Isometry2d &T_odom_base);
+
+  /// Continues from a saved state (map points with their integration count, and the last
+  /// pose with its (x, y, yaw) covariance) instead of starting a new map. The next frame's
+  /// odometry is taken to be at `T_map_base` (the robot did not move in between); it is
+  /// registered against the restored map.
+  void resume(std::vector<MapPoint> points, int integrations, const Eigen::Isometry2d &T_map_base,
+              const Eigen::Matrix3d &covariance);
 
   [[nodiscard]] const PointMap &map() const { return map_; }
 
@@ -66,12 +93,16 @@ class Slam {
   [[nodiscard]] bool accept(const TrimmedIcpResult &registration, const Eigen::Isometry2d &predicted,
                             const Eigen::Isometry2d &estimate, double srel_limit_percent) const;
   [[nodiscard]] FrameEstimate register_scan(const Points2 &scan_base, const Eigen::Isometry2d &predicted);
+  [[nodiscard]] FrameEstimate seed_map(const Points2 &scan_base);
+  [[nodiscard]] bool accept_without_odometry(const TrimmedIcpResult &registration,
+                                             const Eigen::Isometry2d &predicted,
+                                             const Eigen::Isometry2d &estimate) const;
 
   SlamConfig config_;
   PointMap map_;
   std::optional<Eigen::Isometry2d> previous_T_odom_base_;
   FrameEstimate previous_;
-  Points2 previous_scan_map_;  ///< the previous scan at its estimated (or propagated) pose
+  std::deque<Points2> recent_scans_map_;  ///< newest first: the last scans at their estimated poses
   double relaxation_percent_ = 0.0;
   bool previous_failed_ = false;
 };
