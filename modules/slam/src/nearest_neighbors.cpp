@@ -37,7 +37,7 @@ NearestNeighbors::NearestNeighbors(NearestNeighbors &&other) noexcept
     : points_(std::move(other.points_)),
       index_(std::move(other.index_)),
       normals_(std::move(other.normals_)),
-      normals_ready_(other.normals_ready_) {
+      normal_known_(std::move(other.normal_known_)) {
   if (index_) index_->adaptor.points = &points_;
 }
 
@@ -45,7 +45,7 @@ NearestNeighbors &NearestNeighbors::operator=(NearestNeighbors &&other) noexcept
   points_ = std::move(other.points_);
   index_ = std::move(other.index_);
   normals_ = std::move(other.normals_);
-  normals_ready_ = other.normals_ready_;
+  normal_known_ = std::move(other.normal_known_);
   if (index_) index_->adaptor.points = &points_;
   return *this;
 }
@@ -69,28 +69,31 @@ std::size_t NearestNeighbors::count_within(const Point2 &query, double radius_m)
   return index_->tree.radiusSearch(query.data(), radius_m * radius_m, found, params);
 }
 
-const Points2 &NearestNeighbors::normals() const {
-  if (normals_ready_) return normals_;
+const Point2 &NearestNeighbors::normal(std::size_t index) const {
   constexpr double kNormalRadiusM = 0.15;
-  normals_.assign(points_.size(), Point2::Zero());
+  if (normal_known_.empty()) {
+    normals_.assign(points_.size(), Point2::Zero());
+    normal_known_.assign(points_.size(), false);
+  }
+  if (normal_known_[index]) return normals_[index];
+  normal_known_[index] = true;
   std::vector<std::pair<std::size_t, double>> found;
   nanoflann::SearchParams params;
   params.sorted = false;
-  for (std::size_t i = 0; i < points_.size(); ++i) {
-    index_->tree.radiusSearch(points_[i].data(), kNormalRadiusM * kNormalRadiusM, found, params);
-    if (found.size() < 3) continue;
-    Point2 mean = Point2::Zero();
-    for (const auto &[j, distance_sq] : found) mean += points_[j];
-    mean /= static_cast<double>(found.size());
-    Eigen::Matrix2d scatter = Eigen::Matrix2d::Zero();
-    for (const auto &[j, distance_sq] : found)
-      scatter += (points_[j] - mean) * (points_[j] - mean).transpose();
-    // Eigenvalues ascending: the first eigenvector is across the local line.
-    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> solver(scatter);
-    normals_[i] = solver.eigenvectors().col(0).normalized();
+  index_->tree.radiusSearch(points_[index].data(), kNormalRadiusM * kNormalRadiusM, found, params);
+  if (found.size() < 3) return normals_[index];
+  Point2 mean = Point2::Zero();
+  for (const auto &neighbor : found) mean += points_[neighbor.first];
+  mean /= static_cast<double>(found.size());
+  Eigen::Matrix2d scatter = Eigen::Matrix2d::Zero();
+  for (const auto &neighbor : found) {
+    const Point2 d = points_[neighbor.first] - mean;
+    scatter += d * d.transpose();
   }
-  normals_ready_ = true;
-  return normals_;
+  // Eigenvalues ascending: the first eigenvector is across the local line.
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> solver(scatter);
+  normals_[index] = solver.eigenvectors().col(0).normalized();
+  return normals_[index];
 }
 
 }  // namespace omnislam::slam

@@ -36,14 +36,14 @@ double residual_sq(const Point2 &moved, const Point2 &model, const Point2 &norma
 // model point inside dmax, sort by residual and keep the best overlap * N_p.
 std::vector<Pair> trimmed_pairs(const NearestNeighbors &model, const Points2 &sample, const Motion &motion,
                                 double search_radius_m, const TrimmedIcpConfig &config) {
-  const Points2 *normals = config.metric == IcpMetric::kPointToLine ? &model.normals() : nullptr;
+  const bool with_normals = config.metric == IcpMetric::kPointToLine;
   std::vector<Pair> pairs;
   pairs.reserve(sample.size());
   for (const Point2 &p : sample) {
     const Point2 moved = motion.apply(p);
     if (const auto hit = model.nearest(moved, search_radius_m)) {
       const Point2 &m = model.points()[hit->index];
-      const Point2 normal = normals ? (*normals)[hit->index] : Point2::Zero();
+      const Point2 normal = with_normals ? model.normal(hit->index) : Point2::Zero();
       pairs.push_back({m, normal, p, residual_sq(moved, m, normal, config.metric)});
     }
   }

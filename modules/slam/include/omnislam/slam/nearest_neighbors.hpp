@@ -32,9 +32,10 @@ class NearestNeighbors {
 
   [[nodiscard]] const Points2 &points() const { return points_; }
 
-  /// Unit normal of the local line through each point (PCA of its neighbours within
-  /// 0.15 m), or zero where fewer than 3 points lie there. Computed on first use.
-  [[nodiscard]] const Points2 &normals() const;
+  /// Unit normal of the local line through point `index` (PCA of its neighbours within
+  /// 0.15 m), or zero where fewer than 3 points lie there. Computed on first use and cached,
+  /// so a registration pays only for the points it pairs with.
+  [[nodiscard]] const Point2 &normal(std::size_t index) const;
   [[nodiscard]] bool empty() const { return points_.empty(); }
 
   /// Nearest point within `radius_m` of `query`, or nullopt (also for an empty set).
@@ -48,7 +49,7 @@ class NearestNeighbors {
   Points2 points_;
   std::unique_ptr<Index> index_;
   mutable Points2 normals_;
-  mutable bool normals_ready_ = false;
+  mutable std::vector<bool> normal_known_;
 };
 
 }  // namespace omnislam::slam
