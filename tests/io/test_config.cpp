@@ -111,3 +111,15 @@ TEST_CASE("config: the slam section, and the bundled thesis preset", "[io][confi
   CHECK(thesis.slam.use_srel_test);
   CHECK(thesis.slam.target == omnislam::slam::RegistrationTarget::kPreviousScan);
 }
+
+TEST_CASE("config: the installed defaults (deploy/*.yaml) load", "[io][config]") {
+  const fs::path deploy = fs::path(OMNISLAM_SOURCE_DIR) / "deploy";
+  const omnislam::io::Config service = omnislam::io::load_config(deploy / "omnislamd.yaml");
+  CHECK(service.scan.camera.image_width_px == 1024);
+  CHECK(service.scan.camera_height_m == 1.0);
+  CHECK_FALSE(service.slam.localization_only);
+  CHECK(service.persistence.snapshot_period_s == 30.0);
+  CHECK_FALSE(service.persistence.refuse_corrupt_snapshot);
+  const omnislam::io::Config thesis = omnislam::io::load_config(deploy / "thesis-2008.yaml");
+  CHECK(thesis.slam.target == omnislam::slam::RegistrationTarget::kPreviousScan);
+}

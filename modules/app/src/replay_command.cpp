@@ -1,18 +1,17 @@
 #include "replay_command.hpp"
 
-#include <chrono>
 #include <cstdio>
 #include <filesystem>
 #include <memory>
-#include <optional>
+#include <stdexcept>
 #include <string>
 
+#include "dataset_source.hpp"
+#include "frame_record.hpp"
 #include "omnislam/io/config.hpp"
 #include "omnislam/io/dataset.hpp"
-#include "omnislam/io/image_file.hpp"
+#include "omnislam/pipeline/pipeline.hpp"
 #include "omnislam/slam/odometry_noise.hpp"
-#include "omnislam/slam/slam.hpp"
-#include "omnislam/stereo/scan_reconstructor.hpp"
 #include "poses.hpp"
 #include "run_outputs.hpp"
 
@@ -28,21 +27,6 @@ struct ReplayOptions {
   std::uint64_t seed = 1;
 };
 
-class StageClock {
- public:
-  explicit StageClock(FrameRecord &record) : record_(record), last_(Clock::now()) {}
-  void lap(std::size_t stage) {
-    const auto now = Clock::now();
-    record_.stage_ms[stage] = std::chrono::duration<double, std::milli>(now - last_).count();
-    last_ = now;
-  }
-
- private:
-  using Clock = std::chrono::steady_clock;
-  FrameRecord &record_;
-  Clock::time_point last_;
-};
-
 // Odometry as the robot reports it (the dataset's, or a given TUM or thesis-format file),
 // or the thesis noise model applied to the exact one.
 std::vector<Eigen::Isometry2d> load_odometry(const io::DatasetInfo &info, const ReplayOptions &options) {
@@ -56,13 +40,6 @@ std::vector<Eigen::Isometry2d> load_odometry(const io::DatasetInfo &info, const 
                                            options.seed);
 }
 
-slam::Points2 scan_points(const stereo::LocalScan &scan) {
-  slam::Points2 points;
-  points.reserve(scan.points.size());
-  for (const stereo::ScanPoint &p : scan.points) points.emplace_back(p.x_m, p.y_m);
-  return points;
-}
-
 void run_replay(const ReplayOptions &options) {
   const io::DatasetInfo info = io::read_dataset_info(options.dataset);
   io::Config config = options.config_file.empty() ? io::Config{} : io::load_config(options.config_file);
@@ -74,8 +51,6 @@ void run_replay(const ReplayOptions &options) {
     throw std::runtime_error("odometry has " + std::to_string(odometry.size()) + " poses for " +
                              std::to_string(info.frames) + " frames");
   }
-  stereo::ScanReconstructor reconstructor(config.scan);
-  slam::Slam slam(config.slam);
   RunRecord run;
   run.odometry_map = relative_to_first(odometry);
   run.odometry_map.resize(static_cast<std::size_t>(info.frames));
@@ -85,46 +60,25 @@ void run_replay(const ReplayOptions &options) {
   }
   OutputWriter writer(options.out_dir);
 
-  stereo::LocalScan scan;
-  for (int frame = 1; frame <= info.frames; ++frame) {
-    FrameRecord record;
-    record.t_s = (frame - 1) / info.rate_hz;
-    record.T_odom_base = odometry[static_cast<std::size_t>(frame - 1)];
-    StageClock clock(record);
-    cv::Mat image;
-    try {
-      image = io::read_camera_image(info.image(frame), config.scan.camera);
-    } catch (const std::exception &error) {
-      std::fprintf(stderr, "omnislam replay: frame %d skipped: %s\n", frame, error.what());
-      record.skipped = true;
-    }
-    clock.lap(0);
-    scan.points.clear();
-    if (!record.skipped) {
-      reconstructor.unwarp(image);
-      clock.lap(1);
-      reconstructor.detect_edges();
-      clock.lap(2);
-      reconstructor.select_edges();
-      clock.lap(3);
-      reconstructor.match();
-      clock.lap(4);
-      reconstructor.triangulate(scan);
-      clock.lap(5);
-    }
-    const slam::FrameEstimate estimate = slam.process(scan_points(scan), record.T_odom_base);
-    clock.lap(6);
-    record.T_map_base = estimate.T_map_base;
-    record.covariance = estimate.covariance;
-    record.integrated = estimate.integrated;
-    record.attempt = estimate.attempt;
-    record.srel_percent = estimate.registration.srel_percent;
-    record.iterations = estimate.registration.iterations;
-    record.scan_points = static_cast<int>(scan.points.size());
-    run.frames.push_back(record);
-    if (record.integrated) writer.write_thesis_map(frame, slam.map());
-  }
-  writer.write_all(run, slam.map(), info);
+  // The service's pipeline in replay mode: blocking queues, so no frame is dropped and
+  // the result equals a sequential run.
+  pipeline::PipelineConfig pipeline_config;
+  pipeline_config.mode = pipeline::Mode::kReplay;
+  pipeline_config.map_every_integration = true;  // the thesis's mapaN.txt after every image
+  pipeline::Sinks sinks;
+  sinks.frame = [&](const pipeline::Frame &frame) {
+    run.frames.push_back(frame_record(frame));
+    if (frame.estimate.integrated && frame.map)
+      writer.write_thesis_map(static_cast<int>(frame.sequence), *frame.map);
+  };
+  DatasetSourceOptions source_options;
+  source_options.on_skip = [](int frame, const std::string &error) {
+    std::fprintf(stderr, "omnislam replay: frame %d skipped: %s\n", frame, error.c_str());
+  };
+  pipeline::Pipeline pipeline(config.scan, config.slam, pipeline_config, std::move(sinks));
+  pipeline.run(dataset_source(info, odometry, config.scan.camera, std::move(source_options)));
+  if (!pipeline.error().empty()) throw std::runtime_error(pipeline.error());
+  writer.write_all(run, pipeline.slam().map(), info);
 }
 
 }  // namespace

@@ -9,6 +9,7 @@
 #include <string>
 
 #include "omnislam/io/run_files.hpp"
+#include "omnislam/pipeline/profiler.hpp"
 #include "omnislam/slam/evaluation.hpp"
 #include "poses.hpp"
 
@@ -89,12 +90,28 @@ std::string profile_csv(const RunRecord &run, bool thesis_timelog) {
   out << (thesis_timelog ? "# image" : "frame");
   for (std::string_view stage : kStages)
     out << (thesis_timelog ? " " : ",") << stage << (thesis_timelog ? "" : "_ms");
+  // profile.csv goes on with the pipeline's queues (the thesis's timelog stops at the stages).
+  if (!thesis_timelog) {
+    for (std::string_view queue : kQueues) out << ",wait_" << queue << "_ms";
+    for (std::string_view queue : kQueues) out << ",depth_" << queue;
+    out << ",latency_ms,dropped_before";
+  }
   out << '\n';
   char value[32];
   for (std::size_t i = 0; i < run.frames.size(); ++i) {
+    const FrameRecord &f = run.frames[i];
     out << i + 1;
-    for (double ms : run.frames[i].stage_ms) {
+    for (double ms : f.stage_ms) {
       std::snprintf(value, sizeof value, "%s%.4f", thesis_timelog ? " " : ",", ms);
+      out << value;
+    }
+    if (!thesis_timelog) {
+      for (double ms : f.wait_ms) {
+        std::snprintf(value, sizeof value, ",%.4f", ms);
+        out << value;
+      }
+      for (int depth : f.queue_depth) out << ',' << depth;
+      std::snprintf(value, sizeof value, ",%.4f,%d", f.latency_ms, f.dropped_before);
       out << value;
     }
     out << '\n';
@@ -131,10 +148,10 @@ OutputWriter::OutputWriter(std::filesystem::path dir) : dir_(std::move(dir)) {
   if (error) throw std::runtime_error("cannot create " + dir_.string() + ": " + error.message());
 }
 
-void OutputWriter::write_thesis_map(int frame, const slam::PointMap &map) const {
+void OutputWriter::write_thesis_map(int frame, const std::vector<slam::MapPoint> &points) const {
   std::ostringstream out;
   char line[96];
-  for (const slam::MapPoint &p : map.points()) {
+  for (const slam::MapPoint &p : points) {
     std::snprintf(line, sizeof line, "%.3f %.3f %d\n", p.position_m.x() * kMmPerM, p.position_m.y() * kMmPerM,
                   p.hits);
     out << line;
@@ -171,6 +188,15 @@ void OutputWriter::write_all(const RunRecord &run, const slam::PointMap &map,
   summary["skipped"] = std::count_if(run.frames.begin(), run.frames.end(), [](auto &f) { return f.skipped; });
   summary["map_points"] = map.points().size();
   summary["stage_ms"] = stage_statistics(run.frames);
+  std::vector<double> latency_ms;
+  long dropped = 0;
+  for (const FrameRecord &f : run.frames) {
+    latency_ms.push_back(f.latency_ms);
+    dropped += f.dropped_before;
+  }
+  const pipeline::DurationStats latency = pipeline::summarize(latency_ms);
+  summary["latency_ms"] = {{"mean", latency.mean_ms}, {"p50", latency.p50_ms}, {"p99", latency.p99_ms}};
+  summary["dropped"] = dropped;
   if (run.ground_truth.size() == estimate.size() && !estimate.empty()) {
     const auto slam_error = slam::trajectory_error(estimate, run.ground_truth);
     const auto odometry_error = slam::trajectory_error(run.odometry_map, run.ground_truth);

@@ -1,6 +1,7 @@
 #pragma once
 
 #include <filesystem>
+#include <vector>
 
 #include "omnislam/io/dataset.hpp"
 #include "omnislam/slam/point_map.hpp"
@@ -16,7 +17,7 @@ class OutputWriter {
   explicit OutputWriter(std::filesystem::path dir);
 
   /// mapaN.txt: the global map after image N (thesis format: x y count, millimetres).
-  void write_thesis_map(int frame, const slam::PointMap &map) const;
+  void write_thesis_map(int frame, const std::vector<slam::MapPoint> &points) const;
 
   /// Everything else, once the run is over.
   void write_all(const RunRecord &run, const slam::PointMap &map, const io::DatasetInfo &info) const;

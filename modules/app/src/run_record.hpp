@@ -5,13 +5,14 @@
 #include <string_view>
 #include <vector>
 
+#include "omnislam/pipeline/frame.hpp"
 #include "omnislam/slam/slam.hpp"
 
 // What a replay records per frame, and the files it makes of it.
 namespace omnislam::app {
 
-inline constexpr std::array<std::string_view, 7> kStages = {"read",  "unwarp",        "canny", "edges",
-                                                            "match", "triangulation", "slam"};
+using pipeline::kQueues;
+using pipeline::kStages;
 
 struct FrameRecord {
   double t_s = 0.0;
@@ -25,6 +26,10 @@ struct FrameRecord {
   int iterations = 0;
   int scan_points = 0;
   std::array<double, kStages.size()> stage_ms{};
+  std::array<double, kQueues.size()> wait_ms{};  ///< time in each pipeline queue
+  std::array<int, kQueues.size()> queue_depth{};
+  double latency_ms = 0.0;  ///< capture -> pose handed to the outputs
+  int dropped_before = 0;   ///< frames dropped by capture just before this one (live mode)
 };
 
 struct RunRecord {

@@ -11,6 +11,9 @@
 namespace omnislam::io {
 namespace detail {
 
+// omnislamd's sections (service_config.cpp).
+void read_service_sections(YamlSection &top, const std::string &file, ServiceConfig &service);
+
 void read_camera_fields(YamlSection &section, mirror::MirrorConfig &camera) {
   section.read("width", camera.image_width_px);
   section.read("height", camera.image_height_px);
@@ -154,9 +157,29 @@ void read_slam(YamlSection &section, slam::SlamConfig &slam) {
   section.read("prune_every", slam.map.prune_every);
   section.read("prune_min_hits", slam.map.prune_min_hits);
   section.read("prune_min_age", slam.map.prune_min_age);
+  section.read("localization_only", slam.localization_only);
   if (!(slam.icp.overlap > 0.0 && slam.icp.overlap <= 1.0)) section.fail("overlap", "must be in (0, 1]");
   if (!(slam.icp.initial_search_radius_m > 0.0)) section.fail("initial_search_radius_m", "must be positive");
-  if (slam.icp.max_iterations < 1) section.fail("max_iterations", "must be at least 1");
+  if (slam.icp.max_iterations < 1 || slam.icp.max_iterations > 1000) {
+    section.fail("max_iterations", "must be in 1..1000");
+  }
+  for (const auto &[key, value] : {std::pair{"max_rms_m", slam.max_rms_m},
+                                   {"fusion_radius_m", slam.map.fusion_radius_m},
+                                   {"noise_radius_m", slam.map.noise_radius_m}}) {
+    if (!(value > 0.0)) section.fail(key, "must be positive");
+  }
+  for (const auto &[key, value] : {std::pair{"srel_limit_percent", slam.srel_limit_percent},
+                                   {"srel_relax_percent", slam.srel_relax_percent},
+                                   {"max_correction_m", slam.max_correction_m}}) {
+    if (value < 0.0) section.fail(key, "must be >= 0");
+  }
+  for (const auto &[key, value] : {std::pair{"min_scan_points", slam.min_scan_points},
+                                   {"noise_min_neighbors", slam.map.noise_min_neighbors},
+                                   {"prune_every", slam.map.prune_every},
+                                   {"prune_min_hits", slam.map.prune_min_hits},
+                                   {"prune_min_age", slam.map.prune_min_age}}) {
+    if (value < 0) section.fail(key, "must be >= 0");
+  }
   if (!(slam.min_inlier_share >= 0.0 && slam.min_inlier_share <= 1.0)) {
     section.fail("min_inlier_share", "must be in [0, 1]");
   }
@@ -192,6 +215,17 @@ Config load_config(const std::filesystem::path &file) {
     read_slam(slam, config.slam);
     slam.finish();
   }
+  if (top.has("persistence")) {
+    YamlSection persistence(top.node("persistence"), "persistence", name);
+    persistence.read("snapshot_period_s", config.persistence.snapshot_period_s);
+    if (config.persistence.snapshot_period_s < 0.0) persistence.fail("snapshot_period_s", "must be >= 0");
+    bool refuse = config.persistence.refuse_corrupt_snapshot;
+    read_choice(persistence, "on_corrupt_snapshot", refuse, {{"start_fresh", false}, {"refuse", true}},
+                "must be start_fresh or refuse");
+    config.persistence.refuse_corrupt_snapshot = refuse;
+    persistence.finish();
+  }
+  detail::read_service_sections(top, name, config.service);
   top.finish();
   return config;
 }

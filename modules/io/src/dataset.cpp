@@ -2,12 +2,32 @@
 
 #include <cstdio>
 #include <stdexcept>
+#include <string>
 #include <vector>
 
 #include "camera_fields.hpp"
 #include "yaml_fields.hpp"
 
 namespace omnislam::io {
+namespace {
+
+// The images pattern goes to snprintf with one int: allow exactly one %d with optional
+// zero flag and width, and %% escapes, nothing else (no %s, %n, ...).
+bool is_frame_pattern(const std::string &pattern) {
+  int fields = 0;
+  for (std::size_t i = 0; i < pattern.size(); ++i) {
+    if (pattern[i] != '%') continue;
+    if (++i < pattern.size() && pattern[i] == '%') continue;
+    if (i < pattern.size() && pattern[i] == '0') ++i;
+    std::size_t digits = 0;
+    while (i < pattern.size() && pattern[i] >= '0' && pattern[i] <= '9' && digits < 2) ++i, ++digits;
+    if (i >= pattern.size() || pattern[i] != 'd') return false;
+    ++fields;
+  }
+  return fields == 1;
+}
+
+}  // namespace
 
 std::filesystem::path DatasetInfo::image(int frame) const {
   std::vector<char> name(images.size() + 32);
@@ -46,6 +66,9 @@ DatasetInfo read_dataset_info(const std::filesystem::path &dir) {
   path_of("odometry_exact", info.odometry_exact);
   path_of("floorplan", info.floorplan);
   if (info.frames < 0) top.fail("frames", "must be >= 0");
+  if (!is_frame_pattern(info.images)) {
+    top.fail("images", "must be a path with one frame-number field like %06d (and %% for a literal %)");
+  }
   return info;
 }
 

@@ -2,8 +2,9 @@
 
 #include <cstdio>
 #include <fstream>
-#include <sstream>
 #include <stdexcept>
+
+#include "number_fields.hpp"
 
 namespace omnislam::io {
 namespace {
@@ -63,14 +64,17 @@ std::vector<MapPointRecord> read_map_csv(const std::filesystem::path &file) {
   int number = 0;
   while (std::getline(in, line)) {
     ++number;
-    if (number == 1 || line.empty()) continue;  // header
+    if (number == 1 || line.find_first_not_of(" \t\r") == std::string::npos) continue;  // header
+    const auto where = file.string() + ":" + std::to_string(number) + ": ";
+    const auto fields = detail::split_fields(line, true);
+    if (fields.size() != 3) throw std::runtime_error(where + "expected x,y,hits, got '" + line + "'");
     MapPointRecord p;
-    char comma1 = 0, comma2 = 0;
-    std::istringstream fields(line);
-    if (!(fields >> p.x_m >> comma1 >> p.y_m >> comma2 >> p.hits) || comma1 != ',' || comma2 != ',') {
-      throw std::runtime_error(file.string() + ":" + std::to_string(number) + ": expected x,y,hits, got '" +
-                               line + "'");
-    }
+    long hits = 0;
+    if (auto error = detail::parse_finite(fields[0], "x", p.x_m)) throw std::runtime_error(where + *error);
+    if (auto error = detail::parse_finite(fields[1], "y", p.y_m)) throw std::runtime_error(where + *error);
+    if (auto error = detail::parse_integer(fields[2], "hits", hits)) throw std::runtime_error(where + *error);
+    if (hits < 1 || hits > 1000000000) throw std::runtime_error(where + "'hits' must be in 1..1e9");
+    p.hits = static_cast<int>(hits);
     points.push_back(p);
   }
   return points;

@@ -2,12 +2,14 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <cmath>
 #include <set>
-#include <stdexcept>
 #include <string>
 
-// Typed access to one YAML mapping with errors that name the key and file:line (private
-// to io/; the public headers expose plain structs only).
+#include "omnislam/io/config.hpp"
+
+// Typed access to one YAML mapping with errors (ConfigError) that name the key and
+// file:line (private to io/; the public headers expose plain structs only).
 
 namespace omnislam::io::detail {
 
@@ -23,7 +25,8 @@ class YamlSection {
   YamlSection(const YAML::Node &node, std::string prefix, std::string file)
       : node_(node), prefix_(std::move(prefix)), file_(std::move(file)) {
     if (!node_.IsMap()) {
-      throw std::runtime_error(where(file_, node_.Mark()) + ": '" + prefix_ + "' must be a mapping of keys");
+      throw ConfigError(where(file_, node_.Mark()) + ": " +
+                        (prefix_.empty() ? "the file" : "'" + prefix_ + "'") + " must be a mapping of keys");
     }
   }
 
@@ -45,24 +48,31 @@ class YamlSection {
     try {
       value = field.as<T>();
     } catch (const YAML::Exception &) {
-      throw std::runtime_error(where(file_, field.Mark()) + ": '" + key_name(key) + "' must be " + expected);
+      throw ConfigError(where(file_, field.Mark()) + ": '" + key_name(key) + "' must be " + expected);
     }
   }
 
-  void read(const std::string &key, double &value) { read<double>(key, value, "a number"); }
+  void read(const std::string &key, double &value) {
+    read<double>(key, value, "a number");
+    if (has(key) && !std::isfinite(value)) fail(key, "must be a finite number");
+  }
   void read(const std::string &key, int &value) { read<int>(key, value, "an integer"); }
   void read(const std::string &key, bool &value) { read<bool>(key, value, "true or false"); }
   void read(const std::string &key, std::string &value) { read<std::string>(key, value, "a string"); }
 
   [[noreturn]] void fail(const std::string &key, const std::string &message) const {
-    throw std::runtime_error(where(file_, node_[key].Mark()) + ": '" + key_name(key) + "' " + message);
+    throw ConfigError(where(file_, node_[key].Mark()) + ": '" + key_name(key) + "' " + message);
   }
 
   void finish() const {
     for (const auto &entry : node_) {
+      if (!entry.first.IsScalar()) {
+        throw ConfigError(where(file_, entry.first.Mark()) + ": a key of '" + prefix_ +
+                          "' is not a plain name");
+      }
       const auto key = entry.first.as<std::string>();
       if (!seen_.contains(key)) {
-        throw std::runtime_error(where(file_, entry.first.Mark()) + ": unknown key '" + key_name(key) + "'");
+        throw ConfigError(where(file_, entry.first.Mark()) + ": unknown key '" + key_name(key) + "'");
       }
     }
   }
@@ -74,14 +84,14 @@ class YamlSection {
   std::set<std::string> seen_;
 };
 
-/// Loads a YAML file, turning parse errors into std::runtime_error naming file:line.
+/// Loads a YAML file, turning parse errors into ConfigError naming file:line.
 [[nodiscard]] inline YAML::Node load_yaml(const std::string &file) {
   try {
     return YAML::LoadFile(file);
   } catch (const YAML::BadFile &) {
-    throw std::runtime_error(file + ": cannot open the file");
+    throw ConfigError(file + ": cannot open the file");
   } catch (const YAML::ParserException &error) {
-    throw std::runtime_error(where(file, error.mark) + ": " + error.msg);
+    throw ConfigError(where(file, error.mark) + ": " + error.msg);
   }
 }
 

@@ -4,6 +4,7 @@
 #include <array>
 #include <cmath>
 #include <numbers>
+#include <utility>
 
 #include "omnislam/mirror/panorama_maps.hpp"
 #include "omnislam/vision/texture.hpp"
@@ -121,6 +122,11 @@ void ScanReconstructor::match() {
     match_column(inner_.candidates.column(column), outer_.candidates.column(column), column, inner_.texture,
                  outer_.texture, limits_, config_.vision.selection, config_.stereo, matches_, match_stats_);
   }
+}
+
+void ScanReconstructor::swap_lobes(LobeWork &inner, LobeWork &outer) noexcept {
+  std::swap(inner_, inner);
+  std::swap(outer_, outer);
 }
 
 void ScanReconstructor::triangulate(LocalScan &scan) {

@@ -1,7 +1,9 @@
 #pragma once
 
 #include <filesystem>
+#include <stdexcept>
 
+#include "omnislam/io/service_config.hpp"
 #include "omnislam/slam/slam.hpp"
 #include "omnislam/stereo/stereo_config.hpp"
 
@@ -25,19 +27,38 @@
 ///            use_srel_test, srel_limit_percent, srel_relax_percent, optional_map_correction,
 ///            max_rms_m, min_inlier_share, max_correction_m, max_correction_deg, min_scan_points,
 ///            use_odometry, no_odometry_min_srel_percent, no_odometry_max_rotation_deg, fusion_radius_m,
-///            noise_radius_m, noise_min_neighbors, prune_every, prune_min_hits, prune_min_age}
+///            noise_radius_m, noise_min_neighbors, prune_every, prune_min_hits, prune_min_age,
+///            localization_only}
+/// persistence: {snapshot_period_s, on_corrupt_snapshot: start_fresh | refuse}
+/// input, pipeline, dds, service: omnislamd's sections (service_config.hpp)
 /// ```
 /// The field meanings are documented on the structs (vision_config.hpp, stereo_config.hpp, slam.hpp).
 
 namespace omnislam::io {
 
+/// An invalid configuration (or dataset.yaml): unreadable file, YAML syntax, unknown key,
+/// wrong type, value out of range. The message names the file:line:column and the key.
+/// The commands exit with code 2 on it, which the service unit does not restart on.
+class ConfigError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+/// State persistence of the service (io/snapshot.hpp).
+struct PersistenceConfig {
+  double snapshot_period_s = 30.0;       ///< how often the map and pose are saved; 0 = only at shutdown
+  bool refuse_corrupt_snapshot = false;  ///< false: a corrupt snapshot is moved aside and a new map started
+};
+
 struct Config {
   stereo::ScanConfig scan;
   slam::SlamConfig slam;
+  PersistenceConfig persistence;
+  ServiceConfig service;  ///< omnislamd: input, pipeline, dds, service (service_config.hpp)
 };
 
-/// Reads a configuration file on top of the defaults. Throws std::runtime_error naming
-/// the file (and file:line:column of the offending key) on any problem.
+/// Reads a configuration file on top of the defaults. Throws ConfigError naming the file
+/// (and file:line:column of the offending key) on any problem.
 [[nodiscard]] Config load_config(const std::filesystem::path &file);
 
 }  // namespace omnislam::io

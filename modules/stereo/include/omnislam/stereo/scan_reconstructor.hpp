@@ -50,6 +50,11 @@ class ScanReconstructor {
   void match();                       ///< step 5, every column pair
   void triangulate(LocalScan &scan);  ///< steps 6-7, with the stats of all steps
 
+  /// Exchanges the per-frame state of both lobes (what select_edges() leaves for match())
+  /// with `inner` and `outer`, so that two instances with the same configuration can run
+  /// the stages up to select_edges() and from match() on, e.g. in two threads.
+  void swap_lobes(LobeWork &inner, LobeWork &outer) noexcept;
+
   [[nodiscard]] const ScanConfig &config() const { return config_; }
   [[nodiscard]] const mirror::MirrorModel &model() const { return model_; }
   [[nodiscard]] const DisparityLimits &disparity_limits() const { return limits_; }

@@ -1,0 +1,34 @@
+#pragma once
+
+#include <Eigen/Geometry>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "omnislam/io/dataset.hpp"
+#include "omnislam/pipeline/pipeline.hpp"
+
+// Frames of a dataset directory for the pipeline's capture stage.
+namespace omnislam::app {
+
+struct DatasetSourceOptions {
+  int loops = 1;  ///< play the dataset this many times (stamps keep increasing)
+  /// Called (on the capture thread) for an image that cannot be used; the frame goes on
+  /// as skipped, so SLAM still gets its odometry.
+  std::function<void(int frame, const std::string &error)> on_skip;
+};
+
+/// Frame i (1-based) of the dataset: stamp (i - 1) / rate_hz, odometry[i - 1] (odometry
+/// poses of the dataset's frames, any fixed odom frame), the image read and checked
+/// against `camera`.
+[[nodiscard]] pipeline::FrameSource dataset_source(const io::DatasetInfo &info,
+                                                   std::vector<Eigen::Isometry2d> odometry,
+                                                   const mirror::MirrorConfig &camera,
+                                                   DatasetSourceOptions options = {});
+
+/// The same from images decoded beforehand (benchmarks): no file access while running.
+[[nodiscard]] pipeline::FrameSource memory_source(std::vector<cv::Mat> images,
+                                                  std::vector<Eigen::Isometry2d> odometry, double rate_hz,
+                                                  int loops);
+
+}  // namespace omnislam::app

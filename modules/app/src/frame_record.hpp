@@ -1,0 +1,29 @@
+#pragma once
+
+#include "omnislam/pipeline/frame.hpp"
+#include "run_record.hpp"
+
+namespace omnislam::app {
+
+/// What the run files keep of a frame that went through the pipeline.
+[[nodiscard]] inline FrameRecord frame_record(const pipeline::Frame &frame) {
+  FrameRecord record;
+  record.t_s = frame.stamp_s;
+  record.T_map_base = frame.estimate.T_map_base;
+  record.T_odom_base = frame.T_odom_base;
+  record.covariance = frame.estimate.covariance;
+  record.skipped = frame.skipped();
+  record.integrated = frame.estimate.integrated;
+  record.attempt = frame.estimate.attempt;
+  record.srel_percent = frame.estimate.registration.srel_percent;
+  record.iterations = frame.estimate.registration.iterations;
+  record.scan_points = static_cast<int>(frame.scan.points.size());
+  record.stage_ms = frame.timings.stage_ms;
+  record.wait_ms = frame.timings.wait_ms;
+  record.queue_depth = frame.timings.queue_depth;
+  record.latency_ms = frame.timings.latency_ms;
+  record.dropped_before = static_cast<int>(frame.dropped_before);
+  return record;
+}
+
+}  // namespace omnislam::app

@@ -1,0 +1,126 @@
+#include "map_command.hpp"
+
+#include <cinttypes>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <numbers>
+#include <string>
+
+#include "omnislam/io/run_files.hpp"
+#include "omnislam/io/snapshot.hpp"
+#include "poses.hpp"
+
+namespace omnislam::app {
+namespace {
+
+void print_info(const std::filesystem::path &file) {
+  const io::Snapshot s = io::read_snapshot(file);
+  const double yaw_deg =
+      std::atan2(s.T_map_base.linear()(1, 0), s.T_map_base.linear()(0, 0)) * 180.0 / std::numbers::pi;
+  const io::SnapshotCounters &n = s.counters;
+  std::printf("snapshot: %s\n", file.c_str());
+  std::printf("version: %u\n", io::kSnapshotVersion);
+  std::printf("config_hash: %016" PRIx64 "\n", s.config_hash);
+  std::printf("map points: %zu (after %d integrations)\n", s.points.size(), s.map_integrations);
+  std::printf("pose: x %.4f m, y %.4f m, yaw %.3f deg, t %.3f s\n", s.T_map_base.translation().x(),
+              s.T_map_base.translation().y(), yaw_deg, s.t_s);
+  std::printf("pose sigma: x %.4f m, y %.4f m, yaw %.3f deg\n", std::sqrt(s.covariance(0, 0)),
+              std::sqrt(s.covariance(1, 1)), std::sqrt(s.covariance(2, 2)) * 180.0 / std::numbers::pi);
+  std::printf("frames: %" PRIu64 ", integrated %" PRIu64 ", not integrated %" PRIu64 ", skipped %" PRIu64
+              ", dropped %" PRIu64 "\n",
+              n.frames, n.integrated, n.not_integrated, n.skipped, n.dropped);
+}
+
+// The last row of covariance.csv ("frame,t,xx,xy,yy,xyaw,yyaw,yawyaw"), or zero.
+Eigen::Matrix3d last_covariance(const std::filesystem::path &file) {
+  Eigen::Matrix3d c = Eigen::Matrix3d::Zero();
+  std::ifstream in(file);
+  std::string line, last;
+  while (std::getline(in, line))
+    if (!line.empty()) last = line;
+  double t = 0.0, xx = 0.0, xy = 0.0, yy = 0.0, xyaw = 0.0, yyaw = 0.0, yawyaw = 0.0;
+  long frame = 0;
+  if (std::sscanf(last.c_str(), "%ld,%lf,%lf,%lf,%lf,%lf,%lf,%lf", &frame, &t, &xx, &xy, &yy, &xyaw, &yyaw,
+                  &yawyaw) == 8) {
+    c << xx, xy, xyaw, xy, yy, yyaw, xyaw, yyaw, yawyaw;
+  }
+  return c;
+}
+
+// A snapshot of a replay's output: map.csv, the last pose of trajectory.tum, and (when
+// present) the last covariance and summary.json's counters.
+void save(const std::filesystem::path &run_dir, const std::filesystem::path &file,
+          const std::filesystem::path &config_file) {
+  io::Snapshot s;
+  s.config_hash = io::config_file_hash(config_file);
+  const auto trajectory = io::read_tum_file(run_dir / "trajectory.tum");
+  if (trajectory.empty()) throw std::runtime_error((run_dir / "trajectory.tum").string() + ": no poses");
+  s.t_s = trajectory.back().t_s;
+  s.T_map_base = to_isometry(trajectory.back());
+  s.covariance = last_covariance(run_dir / "covariance.csv");
+  s.counters.frames = trajectory.size();
+  if (std::ifstream summary_file{run_dir / "summary.json"}) {
+    const auto summary = nlohmann::json::parse(summary_file, nullptr, false);
+    const auto count = [&](const char *key) { return summary.value(key, std::uint64_t{0}); };
+    if (!summary.is_discarded() && summary.is_object()) {
+      s.counters = {count("frames"), count("integrated"), count("not_integrated"), count("skipped"),
+                    count("dropped")};
+    }
+  }
+  s.map_integrations = static_cast<int>(s.counters.integrated);
+  for (const io::MapPointRecord &p : io::read_map_csv(run_dir / "map.csv")) {
+    s.points.push_back({{p.x_m, p.y_m}, p.hits, 0});
+  }
+  io::write_snapshot(file, s);
+  std::printf("saved %zu map points and the pose of frame %zu to %s\n", s.points.size(), trajectory.size(),
+              file.c_str());
+}
+
+void load(const std::filesystem::path &file, const std::filesystem::path &out_dir) {
+  const io::Snapshot s = io::read_snapshot(file);
+  std::filesystem::create_directories(out_dir);
+  std::vector<io::MapPointRecord> records;
+  records.reserve(s.points.size());
+  for (const slam::MapPoint &p : s.points) records.push_back({p.position_m.x(), p.position_m.y(), p.hits});
+  io::write_map_csv(out_dir / "map.csv", records);
+  io::write_map_ply(out_dir / "map.ply", records);
+  io::write_tum_file(out_dir / "pose.tum", {to_stamped(s.t_s, s.T_map_base)});
+  std::printf("wrote %zu map points to %s (map.csv, map.ply) and the pose to pose.tum\n", records.size(),
+              out_dir.c_str());
+}
+
+}  // namespace
+
+void add_map_command(CLI::App &app) {
+  auto *map = app.add_subcommand("map", "inspect, make and export map snapshots (the service's state)");
+  map->require_subcommand(1);
+
+  auto info_file = std::make_shared<std::string>();
+  auto *info = map->add_subcommand("info", "print a snapshot's version, map size, pose and counters");
+  info->add_option("file", *info_file, "snapshot file")->required();
+  info->callback([info_file] { print_info(*info_file); });
+
+  struct SaveOptions {
+    std::string run_dir, file, config;
+  };
+  auto save_options = std::make_shared<SaveOptions>();
+  auto *save_command =
+      map->add_subcommand("save", "make a snapshot from an `omnislam replay` output directory");
+  save_command->add_option("run", save_options->run_dir, "output directory of omnislam replay")->required();
+  save_command->add_option("file", save_options->file, "snapshot file to write")->required();
+  save_command->add_option("--config", save_options->config, "the configuration of the run (for its hash)");
+  save_command->callback(
+      [save_options] { save(save_options->run_dir, save_options->file, save_options->config); });
+
+  auto load_file = std::make_shared<std::string>();
+  auto load_dir = std::make_shared<std::string>();
+  auto *load_command = map->add_subcommand("load", "export a snapshot's map as map.csv and map.ply");
+  load_command->add_option("file", *load_file, "snapshot file")->required();
+  load_command->add_option("--out", *load_dir, "output directory")->required();
+  load_command->callback([load_file, load_dir] { load(*load_file, *load_dir); });
+}
+
+}  // namespace omnislam::app

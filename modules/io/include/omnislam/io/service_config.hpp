@@ -1,0 +1,59 @@
+#pragma once
+
+#include <string>
+
+/// @file
+/// omnislamd's own sections of the YAML configuration (read by load_config with the
+/// algorithm sections; architecture.md "Service"):
+///
+/// ```yaml
+/// input:    {source: directory | dataset | camera | video, path, device, rate_hz, loops,
+///            odometry: dataset | dds | none, odometry_topic}
+/// pipeline: {mode: live | replay, queue_capacity, map_rate_hz, profile_period_s, profile_window}
+/// dds:      {enabled, domain_id, config, wait_for_subscribers, wait_timeout_s}
+/// service:  {output_dir}
+/// ```
+
+namespace omnislam::io {
+
+struct InputConfig {
+  /// dataset: a dataset directory (images, rate and odometry from its dataset.yaml);
+  /// directory: images in `path` (sorted by name); camera: cv::VideoCapture(device);
+  /// video: cv::VideoCapture(path).
+  std::string source = "dataset";
+  std::string path;  ///< dataset directory, image directory or video file
+  int device = 0;    ///< camera index for source camera
+  /// Frames per second to feed the pipeline: < 0 the dataset's own rate (or the
+  /// camera's), 0 as fast as possible, > 0 this rate.
+  double rate_hz = -1.0;
+  int loops = 1;  ///< play a dataset or directory this many times
+  /// Odometry source, matched to frames by timestamp: dataset (its odometry.tum), dds
+  /// (nav_msgs Odometry on odometry_topic) or none.
+  std::string odometry = "dataset";
+  std::string odometry_topic = "rt/odom";
+};
+
+struct PipelineSectionConfig {
+  std::string mode = "live";  ///< live: capture drops when the pipeline is full; replay: blocks
+  int queue_capacity = 4;
+  double map_rate_hz = 1.0;  ///< rt/omnislam/map at most this often (on change)
+  double profile_period_s = 1.0;
+  int profile_window = 300;  ///< frames in the rolling statistics
+};
+
+struct DdsSectionConfig {
+  bool enabled = true;
+  int domain_id = 0;
+  std::string config;            ///< Cyclone XML file; empty: CYCLONEDDS_URI or Cyclone's default
+  int wait_for_subscribers = 0;  ///< before starting, wait for this many pose readers ...
+  double wait_timeout_s = 10.0;  ///< ... at most this long (then start anyway, with a warning)
+};
+
+struct ServiceConfig {
+  InputConfig input;
+  PipelineSectionConfig pipeline;
+  DdsSectionConfig dds;
+  std::string output_dir;  ///< trajectory.tum, profile.csv, map.csv at shutdown; empty: none
+};
+
+}  // namespace omnislam::io

@@ -1,0 +1,103 @@
+#pragma once
+
+#include <Eigen/Geometry>
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+#include <span>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "omnislam/slam/point_map.hpp"
+
+/// @file
+/// Snapshots of the SLAM state (map, pose, counters, configuration hash) that a service
+/// writes periodically into its state directory and resumes from after a restart.
+///
+/// File format, version 1 (all integers and doubles little-endian):
+/// ```
+/// offset  size  field
+///  0       8    magic "OMNISNAP"
+///  8       4    u32 format version (1)
+/// 12       8    u64 payload size in bytes
+/// 20       4    u32 CRC-32 (zlib) of bytes 8..19 followed by the payload
+/// 24       -    payload: u64 config_hash, f64 t_s, f64 x_m, f64 y_m, f64 yaw_rad,
+///               9 x f64 covariance (row-major, x y yaw), u64 frames, u64 integrated,
+///               u64 not_integrated, u64 skipped, u64 dropped, i64 map_integrations,
+///               u64 point count, then per point f64 x_m, f64 y_m, i32 hits, i32 first_seen
+/// ```
+
+namespace omnislam::io {
+
+inline constexpr std::uint32_t kSnapshotVersion = 1;
+
+/// A snapshot that cannot be used: missing, truncated, of another version, failing its
+/// checksum, or holding impossible values. The message names the file.
+class SnapshotError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+struct SnapshotCounters {
+  std::uint64_t frames = 0;          ///< frames processed since the map was started
+  std::uint64_t integrated = 0;      ///< frames whose registration was accepted
+  std::uint64_t not_integrated = 0;  ///< frames that followed odometry
+  std::uint64_t skipped = 0;         ///< frames whose image could not be used
+  std::uint64_t dropped = 0;         ///< frames dropped by the live pipeline
+};
+
+struct Snapshot {
+  std::uint64_t config_hash = 0;  ///< config_file_hash() of the configuration that built the map
+  double t_s = 0.0;               ///< capture time of the last frame in the snapshot
+  Eigen::Isometry2d T_map_base = Eigen::Isometry2d::Identity();  ///< last pose (planar)
+  Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();          ///< of (x, y, yaw), map frame
+  SnapshotCounters counters;
+  int map_integrations = 0;  ///< slam::PointMap::integrations() (the age reference of first_seen)
+  std::vector<slam::MapPoint> points;
+};
+
+/// The bytes of the file format above.
+[[nodiscard]] std::vector<std::uint8_t> encode_snapshot(const Snapshot &snapshot);
+
+/// Parses the file format; `name` is used in error messages. Throws SnapshotError on a
+/// truncated or oversized buffer, a bad magic, checksum or version, or a non-finite or
+/// impossible value (hits < 1, first_seen outside 0..map_integrations).
+[[nodiscard]] Snapshot decode_snapshot(std::span<const std::uint8_t> bytes, const std::string &name);
+
+/// Writes `snapshot` so that `file` always holds either the previous or the new complete
+/// snapshot, even across a crash or power loss: a temporary file in the same directory,
+/// fsync, rename over `file`, fsync of the directory. Throws std::runtime_error naming the
+/// file and the failing system call.
+void write_snapshot(const std::filesystem::path &file, const Snapshot &snapshot);
+
+/// Reads and checks a snapshot file. Throws SnapshotError (see decode_snapshot), also when
+/// the file cannot be read.
+[[nodiscard]] Snapshot read_snapshot(const std::filesystem::path &file);
+
+/// Renames `file` to `file`.corrupt-N with the smallest N not yet taken, keeping it for
+/// inspection; returns the new path. Throws std::runtime_error when the rename fails.
+std::filesystem::path move_aside(const std::filesystem::path &file);
+
+/// What to do when the snapshot to resume from is corrupt.
+enum class CorruptSnapshotPolicy {
+  kStartFresh,  ///< move it aside and start a new map
+  kRefuse,      ///< throw: an operator decides
+};
+
+struct ResumeResult {
+  std::optional<Snapshot> snapshot;      ///< empty: start a new map
+  std::string message;                   ///< what happened, for the log
+  std::filesystem::path moved_aside_to;  ///< where a corrupt snapshot went, if it did
+};
+
+/// Resumes from `file` if it exists. A missing file starts fresh; a corrupt one is moved
+/// aside and starts fresh, or (kRefuse) throws SnapshotError and stays where it is.
+[[nodiscard]] ResumeResult resume_from_snapshot(const std::filesystem::path &file,
+                                                CorruptSnapshotPolicy policy);
+
+/// FNV-1a 64-bit hash of a configuration file's bytes (0 for an empty path), stored in
+/// snapshots so a resume under a changed configuration can be noticed.
+[[nodiscard]] std::uint64_t config_file_hash(const std::filesystem::path &file);
+
+}  // namespace omnislam::io

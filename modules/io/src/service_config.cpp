@@ -1,0 +1,88 @@
+#include <initializer_list>
+#include <string>
+
+#include "omnislam/io/config.hpp"
+#include "yaml_fields.hpp"
+
+namespace omnislam::io::detail {
+namespace {
+
+void read_one_of(YamlSection &section, const char *key, std::string &value,
+                 std::initializer_list<const char *> choices) {
+  std::string text = value;
+  section.read(key, text);
+  std::string list;
+  for (const char *choice : choices) {
+    if (text == choice) {
+      value = text;
+      return;
+    }
+    list += (list.empty() ? "" : ", ") + std::string(choice);
+  }
+  section.fail(key, "must be one of " + list);
+}
+
+void read_input(YamlSection &section, InputConfig &input) {
+  read_one_of(section, "source", input.source, {"dataset", "directory", "camera", "video"});
+  section.read("path", input.path);
+  section.read("device", input.device);
+  section.read("rate_hz", input.rate_hz);
+  section.read("loops", input.loops);
+  read_one_of(section, "odometry", input.odometry, {"dataset", "dds", "none"});
+  section.read("odometry_topic", input.odometry_topic);
+  if (input.loops < 1) section.fail("loops", "must be at least 1");
+  if (input.source != "camera" && input.path.empty()) section.fail("source", "needs input.path");
+  if (input.odometry == "dataset" && input.source != "dataset") {
+    section.fail("odometry", "dataset needs source: dataset");
+  }
+}
+
+void read_pipeline(YamlSection &section, PipelineSectionConfig &pipeline) {
+  read_one_of(section, "mode", pipeline.mode, {"live", "replay"});
+  section.read("queue_capacity", pipeline.queue_capacity);
+  section.read("map_rate_hz", pipeline.map_rate_hz);
+  section.read("profile_period_s", pipeline.profile_period_s);
+  section.read("profile_window", pipeline.profile_window);
+  if (pipeline.queue_capacity < 1 || pipeline.queue_capacity > 1024) {
+    section.fail("queue_capacity", "must be in 1..1024");
+  }
+  if (!(pipeline.profile_period_s > 0.0)) section.fail("profile_period_s", "must be positive");
+  if (pipeline.profile_window < 1) section.fail("profile_window", "must be at least 1");
+}
+
+void read_dds(YamlSection &section, DdsSectionConfig &dds) {
+  section.read("enabled", dds.enabled);
+  section.read("domain_id", dds.domain_id);
+  section.read("config", dds.config);
+  section.read("wait_for_subscribers", dds.wait_for_subscribers);
+  section.read("wait_timeout_s", dds.wait_timeout_s);
+  if (dds.domain_id < 0 || dds.domain_id > 232) section.fail("domain_id", "must be in 0..232");
+}
+
+}  // namespace
+
+// The service's sections of load_config (config.cpp), kept apart from the algorithm ones.
+void read_service_sections(YamlSection &top, const std::string &file, ServiceConfig &service) {
+  if (top.has("input")) {
+    YamlSection section(top.node("input"), "input", file);
+    read_input(section, service.input);
+    section.finish();
+  }
+  if (top.has("pipeline")) {
+    YamlSection section(top.node("pipeline"), "pipeline", file);
+    read_pipeline(section, service.pipeline);
+    section.finish();
+  }
+  if (top.has("dds")) {
+    YamlSection section(top.node("dds"), "dds", file);
+    read_dds(section, service.dds);
+    section.finish();
+  }
+  if (top.has("service")) {
+    YamlSection section(top.node("service"), "service", file);
+    section.read("output_dir", service.output_dir);
+    section.finish();
+  }
+}
+
+}  // namespace omnislam::io::detail

@@ -1,0 +1,286 @@
+#include "omnislam/io/snapshot.hpp"
+
+#include <fcntl.h>
+#include <unistd.h>
+#include <zlib.h>
+
+#include <algorithm>
+#include <bit>
+#include <cerrno>
+#include <cmath>
+#include <cstring>
+#include <fstream>
+#include <iterator>
+#include <limits>
+#include <string_view>
+#include <system_error>
+
+namespace omnislam::io {
+namespace {
+
+constexpr std::string_view kMagic = "OMNISNAP";
+constexpr std::size_t kHeaderBytes = 24;  // magic, version, payload size, CRC
+constexpr std::size_t kFixedPayloadBytes = 8 + 8 * 4 + 8 * 9 + 8 * 5 + 8 + 8;
+constexpr std::size_t kPointBytes = 8 + 8 + 4 + 4;
+
+class ByteWriter {
+ public:
+  void u32(std::uint32_t v) { little_endian(v, 4); }
+  void u64(std::uint64_t v) { little_endian(v, 8); }
+  void i32(std::int32_t v) { u32(static_cast<std::uint32_t>(v)); }
+  void i64(std::int64_t v) { u64(static_cast<std::uint64_t>(v)); }
+  void f64(double v) { u64(std::bit_cast<std::uint64_t>(v)); }
+  std::vector<std::uint8_t> bytes;
+
+ private:
+  void little_endian(std::uint64_t v, int size) {
+    for (int i = 0; i < size; ++i) bytes.push_back(static_cast<std::uint8_t>(v >> (8 * i)));
+  }
+};
+
+// Reads fields in order; the caller has checked the total size first, so running past
+// the end is a bug in this file, reported rather than read.
+class ByteReader {
+ public:
+  ByteReader(std::span<const std::uint8_t> bytes, const std::string &name) : bytes_(bytes), name_(name) {}
+  std::uint32_t u32() { return static_cast<std::uint32_t>(little_endian(4)); }
+  std::uint64_t u64() { return little_endian(8); }
+  std::int32_t i32() { return static_cast<std::int32_t>(u32()); }
+  std::int64_t i64() { return static_cast<std::int64_t>(u64()); }
+  double f64(const char *field) {
+    const double v = std::bit_cast<double>(u64());
+    if (!std::isfinite(v)) throw SnapshotError(name_ + ": " + field + " is not a finite number");
+    return v;
+  }
+
+ private:
+  std::uint64_t little_endian(std::size_t size) {
+    if (bytes_.size() - offset_ < size) throw SnapshotError(name_ + ": truncated");
+    std::uint64_t v = 0;
+    for (std::size_t i = 0; i < size; ++i) v |= static_cast<std::uint64_t>(bytes_[offset_ + i]) << (8 * i);
+    offset_ += size;
+    return v;
+  }
+  std::span<const std::uint8_t> bytes_;
+  const std::string &name_;
+  std::size_t offset_ = 0;
+};
+
+std::uint32_t checksum(std::span<const std::uint8_t> header_fields, std::span<const std::uint8_t> payload) {
+  uLong crc = crc32(0L, Z_NULL, 0);
+  crc = crc32(crc, header_fields.data(), static_cast<uInt>(header_fields.size()));
+  // zlib takes uInt lengths: feed large payloads in pieces.
+  for (std::size_t done = 0; done < payload.size();) {
+    const std::size_t piece = std::min<std::size_t>(payload.size() - done, 1u << 30);
+    crc = crc32(crc, payload.data() + done, static_cast<uInt>(piece));
+    done += piece;
+  }
+  return static_cast<std::uint32_t>(crc);
+}
+
+std::string system_error(const std::string &what, const std::filesystem::path &file) {
+  return what + " " + file.string() + ": " + std::strerror(errno);
+}
+
+void write_all(int fd, std::span<const std::uint8_t> bytes, const std::filesystem::path &file) {
+  for (std::size_t done = 0; done < bytes.size();) {
+    const ssize_t n = ::write(fd, bytes.data() + done, bytes.size() - done);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) throw std::runtime_error(system_error("write", file));
+    done += static_cast<std::size_t>(n);
+  }
+}
+
+void fsync_directory(const std::filesystem::path &dir) {
+  const int fd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (fd < 0) throw std::runtime_error(system_error("open directory", dir));
+  const int status = ::fsync(fd);
+  ::close(fd);
+  if (status != 0) throw std::runtime_error(system_error("fsync directory", dir));
+}
+
+}  // namespace
+
+std::vector<std::uint8_t> encode_snapshot(const Snapshot &snapshot) {
+  ByteWriter payload;
+  payload.u64(snapshot.config_hash);
+  payload.f64(snapshot.t_s);
+  const Eigen::Vector2d t = snapshot.T_map_base.translation();
+  payload.f64(t.x());
+  payload.f64(t.y());
+  payload.f64(std::atan2(snapshot.T_map_base.linear()(1, 0), snapshot.T_map_base.linear()(0, 0)));
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) payload.f64(snapshot.covariance(r, c));
+  const SnapshotCounters &n = snapshot.counters;
+  for (std::uint64_t count : {n.frames, n.integrated, n.not_integrated, n.skipped, n.dropped})
+    payload.u64(count);
+  payload.i64(snapshot.map_integrations);
+  payload.u64(snapshot.points.size());
+  for (const slam::MapPoint &p : snapshot.points) {
+    payload.f64(p.position_m.x());
+    payload.f64(p.position_m.y());
+    payload.i32(p.hits);
+    payload.i32(p.first_seen);
+  }
+
+  ByteWriter header;
+  header.bytes.assign(kMagic.begin(), kMagic.end());
+  header.u32(kSnapshotVersion);
+  header.u64(payload.bytes.size());
+  const std::span<const std::uint8_t> checked(header.bytes.data() + kMagic.size(), 12);
+  header.u32(checksum(checked, payload.bytes));
+  header.bytes.insert(header.bytes.end(), payload.bytes.begin(), payload.bytes.end());
+  return std::move(header.bytes);
+}
+
+Snapshot decode_snapshot(std::span<const std::uint8_t> bytes, const std::string &name) {
+  if (bytes.size() < kHeaderBytes) {
+    throw SnapshotError(name + ": truncated: " + std::to_string(bytes.size()) + " bytes, shorter than the " +
+                        std::to_string(kHeaderBytes) + "-byte header");
+  }
+  if (!std::equal(kMagic.begin(), kMagic.end(), bytes.begin())) {
+    throw SnapshotError(name + ": not an omnislam snapshot (bad magic)");
+  }
+  ByteReader header(bytes.subspan(kMagic.size(), kHeaderBytes - kMagic.size()), name);
+  const std::uint32_t version = header.u32();
+  const std::uint64_t payload_size = header.u64();
+  const std::uint32_t stored_crc = header.u32();
+  const std::span<const std::uint8_t> payload = bytes.subspan(kHeaderBytes);
+  if (payload.size() != payload_size) {
+    throw SnapshotError(name + ": " + (payload.size() < payload_size ? "truncated" : "trailing bytes") +
+                        ": the header announces " + std::to_string(payload_size) +
+                        " payload bytes, the file has " + std::to_string(payload.size()));
+  }
+  if (checksum(bytes.subspan(kMagic.size(), 12), payload) != stored_crc) {
+    throw SnapshotError(name + ": checksum mismatch (the file is corrupt)");
+  }
+  if (version != kSnapshotVersion) {
+    throw SnapshotError(name + ": unsupported snapshot version " + std::to_string(version) +
+                        " (this build reads version " + std::to_string(kSnapshotVersion) + ")");
+  }
+  if (payload.size() < kFixedPayloadBytes) throw SnapshotError(name + ": truncated payload");
+
+  ByteReader in(payload, name);
+  Snapshot s;
+  s.config_hash = in.u64();
+  s.t_s = in.f64("t_s");
+  const double x = in.f64("x_m"), y = in.f64("y_m"), yaw = in.f64("yaw_rad");
+  s.T_map_base = Eigen::Translation2d(x, y) * Eigen::Rotation2Dd(yaw);
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) s.covariance(r, c) = in.f64("covariance");
+  SnapshotCounters &n = s.counters;
+  for (std::uint64_t *count : {&n.frames, &n.integrated, &n.not_integrated, &n.skipped, &n.dropped})
+    *count = in.u64();
+  const std::int64_t integrations = in.i64();
+  if (integrations < 0 || integrations > std::numeric_limits<int>::max()) {
+    throw SnapshotError(name + ": map_integrations " + std::to_string(integrations) + " out of range");
+  }
+  s.map_integrations = static_cast<int>(integrations);
+  const std::uint64_t count = in.u64();
+  const std::uint64_t point_bytes = payload.size() - kFixedPayloadBytes;
+  if (point_bytes % kPointBytes != 0 || point_bytes / kPointBytes != count) {
+    throw SnapshotError(name + ": announces " + std::to_string(count) + " map points but holds " +
+                        std::to_string(point_bytes) + " bytes of points");
+  }
+  s.points.reserve(count);
+  for (std::uint64_t i = 0; i < count; ++i) {
+    slam::MapPoint p;
+    p.position_m.x() = in.f64("point x_m");
+    p.position_m.y() = in.f64("point y_m");
+    p.hits = in.i32();
+    p.first_seen = in.i32();
+    if (p.hits < 1 || p.first_seen < 0 || p.first_seen > s.map_integrations) {
+      throw SnapshotError(name + ": map point " + std::to_string(i) + " has hits " + std::to_string(p.hits) +
+                          " and first_seen " + std::to_string(p.first_seen) + " (map_integrations " +
+                          std::to_string(s.map_integrations) + ")");
+    }
+    s.points.push_back(p);
+  }
+  return s;
+}
+
+void write_snapshot(const std::filesystem::path &file, const Snapshot &snapshot) {
+  const std::vector<std::uint8_t> bytes = encode_snapshot(snapshot);
+  const std::filesystem::path dir = file.has_parent_path() ? file.parent_path() : ".";
+  std::filesystem::path temporary = file;
+  temporary += ".tmp";
+  const int fd = ::open(temporary.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  if (fd < 0) throw std::runtime_error(system_error("cannot create", temporary));
+  try {
+    write_all(fd, bytes, temporary);
+    if (::fsync(fd) != 0) throw std::runtime_error(system_error("fsync", temporary));
+  } catch (...) {
+    ::close(fd);
+    ::unlink(temporary.c_str());
+    throw;
+  }
+  if (::close(fd) != 0) {
+    ::unlink(temporary.c_str());
+    throw std::runtime_error(system_error("close", temporary));
+  }
+  // rename() replaces atomically; the directory fsync makes the new name itself durable.
+  if (::rename(temporary.c_str(), file.c_str()) != 0) {
+    const std::string message = system_error("rename to", file);
+    ::unlink(temporary.c_str());
+    throw std::runtime_error(message);
+  }
+  fsync_directory(dir);
+}
+
+Snapshot read_snapshot(const std::filesystem::path &file) {
+  std::ifstream in(file, std::ios::binary);
+  if (!in) throw SnapshotError(file.string() + ": cannot open the snapshot");
+  const std::vector<std::uint8_t> bytes{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+  if (in.bad()) throw SnapshotError(file.string() + ": read error");
+  return decode_snapshot(bytes, file.string());
+}
+
+std::filesystem::path move_aside(const std::filesystem::path &file) {
+  for (int n = 1;; ++n) {
+    std::filesystem::path target = file;
+    target += ".corrupt-" + std::to_string(n);
+    std::error_code exists_error;
+    if (std::filesystem::exists(target, exists_error) || exists_error) continue;
+    std::error_code error;
+    std::filesystem::rename(file, target, error);
+    if (error) throw std::runtime_error("cannot move " + file.string() + " aside: " + error.message());
+    return target;
+  }
+}
+
+ResumeResult resume_from_snapshot(const std::filesystem::path &file, CorruptSnapshotPolicy policy) {
+  ResumeResult result;
+  std::error_code error;
+  if (!std::filesystem::exists(file, error)) {
+    result.message = "no snapshot at " + file.string() + ": starting a new map";
+    return result;
+  }
+  try {
+    result.snapshot = read_snapshot(file);
+    result.message = "resumed from " + file.string() + ": " + std::to_string(result.snapshot->points.size()) +
+                     " map points, " + std::to_string(result.snapshot->counters.frames) + " frames";
+  } catch (const SnapshotError &corrupt) {
+    if (policy == CorruptSnapshotPolicy::kRefuse) {
+      throw SnapshotError(std::string(corrupt.what()) +
+                          "; refusing to start (persistence.on_corrupt: refuse)");
+    }
+    result.moved_aside_to = move_aside(file);
+    result.message =
+        std::string(corrupt.what()) + "; kept as " + result.moved_aside_to.string() + ", starting a new map";
+  }
+  return result;
+}
+
+std::uint64_t config_file_hash(const std::filesystem::path &file) {
+  if (file.empty()) return 0;
+  std::ifstream in(file, std::ios::binary);
+  if (!in) throw std::runtime_error(file.string() + ": cannot open the file");
+  std::uint64_t hash = 0xcbf29ce484222325ull;  // FNV-1a offset basis and prime
+  for (std::istreambuf_iterator<char> it(in), end; it != end; ++it) {
+    hash ^= static_cast<std::uint8_t>(*it);
+    hash *= 0x100000001b3ull;
+  }
+  return hash;
+}
+
+}  // namespace omnislam::io

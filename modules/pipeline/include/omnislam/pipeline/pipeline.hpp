@@ -1,0 +1,121 @@
+#pragma once
+
+#include <array>
+#include <atomic>
+#include <cstdint>
+#include <functional>
+#include <optional>
+#include <string>
+#include <thread>
+
+#include "omnislam/pipeline/frame.hpp"
+#include "omnislam/pipeline/profiler.hpp"
+#include "omnislam/pipeline/spsc_queue.hpp"
+#include "omnislam/slam/slam.hpp"
+#include "omnislam/stereo/stereo_config.hpp"
+
+/// @file
+/// The staged real-time pipeline (architecture.md "Pipeline"): capture -> front-end
+/// (unwarp, Canny, edge selection) -> stereo (DP matching, triangulation) -> SLAM ->
+/// publish, one thread each, joined by bounded SPSC queues of owned frames.
+
+namespace omnislam::pipeline {
+
+enum class Mode {
+  kReplay,  ///< every queue blocks its producer: no drops, results identical to a sequential run
+  kLive,    ///< capture never blocks: a frame that finds the first queue full is dropped and counted
+};
+
+struct PipelineConfig {
+  Mode mode = Mode::kReplay;
+  std::size_t queue_capacity = 4;      ///< frames per queue (each holds an image: memory is bounded)
+  double input_rate_hz = 0.0;          ///< capture paces the source to this rate; 0 = as fast as it delivers
+  bool map_every_integration = false;  ///< attach the map to every integrated frame (thesis mapaN.txt)
+  double map_period_s = 0.5;           ///< otherwise at most this often (<= 0: never)
+  double profile_period_s = 1.0;       ///< profile sink period (wall clock)
+  std::size_t profile_window = 300;    ///< frames in the rolling statistics
+};
+
+/// Called on the capture thread for the next frame: fills stamp_s, image (or error) and
+/// odometry; returns nullptr when the input is exhausted. The pipeline sets sequence and
+/// the capture timings.
+using FrameSource = std::function<FramePtr()>;
+
+/// Outputs, all called on the publish thread (so they need no locking among themselves).
+struct Sinks {
+  std::function<void(const Frame &)> frame;              ///< every frame that got through, in order
+  std::function<void(const ProfileSnapshot &)> profile;  ///< every profile_period_s and once at the end
+};
+
+class Pipeline {
+ public:
+  /// Builds the stage state (remap tables etc.); no thread runs before start().
+  Pipeline(const stereo::ScanConfig &scan, const slam::SlamConfig &slam, PipelineConfig config, Sinks sinks);
+  Pipeline(const Pipeline &) = delete;
+  Pipeline &operator=(const Pipeline &) = delete;
+  /// Stops and joins.
+  ~Pipeline();
+
+  /// Starts the five threads. Call once.
+  void start(FrameSource source);
+  /// Asks capture to stop after the current frame; every captured frame still drains
+  /// through to the sinks. Thread-safe and async-signal-safe (one atomic store).
+  void stop() noexcept;
+  /// Waits for the drained pipeline (the input ended or stop() was called).
+  void join();
+  /// start(), then join(): the whole input through the pipeline.
+  void run(FrameSource source);
+
+  /// A stage busy with one frame for longer than `limit` (a hang, for the watchdog); a
+  /// stage waiting on an empty queue is not stuck. Thread-safe.
+  [[nodiscard]] std::optional<std::size_t> stuck_stage(Clock::duration limit) const;
+
+  [[nodiscard]] std::uint64_t frames_captured() const { return captured_.load(std::memory_order_relaxed); }
+  [[nodiscard]] std::uint64_t frames_dropped() const { return dropped_.load(std::memory_order_relaxed); }
+  [[nodiscard]] std::uint64_t frames_out() const { return out_.load(std::memory_order_relaxed); }
+  /// True once the publish stage has handed on the last frame (join() will not wait). Thread-safe.
+  [[nodiscard]] bool finished() const { return finished_.load(std::memory_order_acquire); }
+
+  /// The SLAM state. Only after join().
+  [[nodiscard]] const slam::Slam &slam() const { return slam_; }
+  /// The first error of the source or a sink (which ends the run early); empty if none. After join().
+  [[nodiscard]] const std::string &error() const { return error_; }
+
+  /// Names of the five threads, the indices of stuck_stage().
+  static constexpr std::array<std::string_view, 5> kThreads = {"capture", "frontend", "stereo", "slam",
+                                                               "publish"};
+
+ private:
+  using Queue = SpscQueue<Frame>;
+
+  void capture_loop(FrameSource source);
+  void frontend_loop();
+  void stereo_loop();
+  void slam_loop();
+  void publish_loop();
+  [[nodiscard]] bool take(Queue &queue, std::size_t index, FramePtr &frame);
+  void forward(Queue &queue, FramePtr &frame);
+  void emit_profile(const Profiler &profiler);
+  void fail(std::string &slot, const std::string &message);
+  void busy(std::size_t thread, bool is_busy);
+
+  stereo::ScanConfig scan_config_;
+  PipelineConfig config_;
+  Sinks sinks_;
+  slam::Slam slam_;
+  std::array<Queue, 4> queues_;
+  std::atomic<bool> stop_{false};   ///< capture stops reading
+  std::atomic<bool> abort_{false};  ///< a sink failed: stop at once, discard what is queued
+  std::atomic<std::uint64_t> captured_{0};
+  std::atomic<std::uint64_t> dropped_{0};
+  std::atomic<std::uint64_t> out_{0};
+  std::atomic<bool> finished_{false};
+  std::array<std::atomic<std::int64_t>, kThreads.size()> busy_since_ns_{};
+  std::string capture_error_;  ///< written by capture, read after join
+  std::string publish_error_;  ///< written by publish, read after join
+  std::string error_;
+  std::array<std::thread, kThreads.size()> threads_;
+  bool started_ = false;
+};
+
+}  // namespace omnislam::pipeline

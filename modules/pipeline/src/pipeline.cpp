@@ -1,0 +1,282 @@
+#include "omnislam/pipeline/pipeline.hpp"
+
+#include <exception>
+#include <utility>
+
+#include "omnislam/stereo/scan_reconstructor.hpp"
+
+namespace omnislam::pipeline {
+namespace {
+
+constexpr std::size_t kFrontend = 0, kStereo = 1, kSlamQueue = 2, kPublish = 3;
+
+std::int64_t now_ns() {
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(Clock::now().time_since_epoch()).count();
+}
+
+// Times consecutive steps of one frame into its stage_ms.
+class StepClock {
+ public:
+  explicit StepClock(Frame &frame) : frame_(frame), last_(Clock::now()) {}
+  void lap(Step step) {
+    const auto now = Clock::now();
+    frame_.timings.stage_ms[step] = ms_between(last_, now);
+    last_ = now;
+  }
+
+ private:
+  Frame &frame_;
+  Clock::time_point last_;
+};
+
+slam::Points2 scan_points(const stereo::LocalScan &scan) {
+  slam::Points2 points;
+  points.reserve(scan.points.size());
+  for (const stereo::ScanPoint &p : scan.points) points.emplace_back(p.x_m, p.y_m);
+  return points;
+}
+
+}  // namespace
+
+Pipeline::Pipeline(const stereo::ScanConfig &scan, const slam::SlamConfig &slam, PipelineConfig config,
+                   Sinks sinks)
+    : scan_config_(scan),
+      config_(config),
+      sinks_(std::move(sinks)),
+      slam_(slam),
+      queues_{Queue(config.queue_capacity), Queue(config.queue_capacity), Queue(config.queue_capacity),
+              Queue(config.queue_capacity)} {}
+
+Pipeline::~Pipeline() {
+  stop();
+  join();
+}
+
+void Pipeline::start(FrameSource source) {
+  if (started_) throw std::logic_error("Pipeline::start called twice");
+  started_ = true;
+  threads_[0] =
+      std::thread([this, source = std::move(source)]() mutable { capture_loop(std::move(source)); });
+  threads_[1] = std::thread([this] { frontend_loop(); });
+  threads_[2] = std::thread([this] { stereo_loop(); });
+  threads_[3] = std::thread([this] { slam_loop(); });
+  threads_[4] = std::thread([this] { publish_loop(); });
+}
+
+void Pipeline::stop() noexcept { stop_.store(true, std::memory_order_relaxed); }
+
+void Pipeline::join() {
+  for (std::thread &thread : threads_) {
+    if (thread.joinable()) thread.join();
+  }
+  error_ = !capture_error_.empty() ? capture_error_ : publish_error_;
+}
+
+void Pipeline::run(FrameSource source) {
+  start(std::move(source));
+  join();
+}
+
+std::optional<std::size_t> Pipeline::stuck_stage(Clock::duration limit) const {
+  const std::int64_t now = now_ns();
+  const std::int64_t limit_ns = std::chrono::duration_cast<std::chrono::nanoseconds>(limit).count();
+  for (std::size_t i = 0; i < busy_since_ns_.size(); ++i) {
+    const std::int64_t since = busy_since_ns_[i].load(std::memory_order_relaxed);
+    if (since != 0 && now - since > limit_ns) return i;
+  }
+  return std::nullopt;
+}
+
+void Pipeline::busy(std::size_t thread, bool is_busy) {
+  busy_since_ns_[thread].store(is_busy ? now_ns() : 0, std::memory_order_relaxed);
+}
+
+void Pipeline::fail(std::string &slot, const std::string &message) {
+  if (slot.empty()) slot = message;
+  abort_.store(true, std::memory_order_relaxed);
+  stop_.store(true, std::memory_order_relaxed);
+}
+
+bool Pipeline::take(Queue &queue, std::size_t index, FramePtr &frame) {
+  if (queue.pop(frame) != PopStatus::kItem) return false;
+  frame->timings.wait_ms[index] = ms_between(frame->enqueued, Clock::now());
+  frame->timings.queue_depth[index] = static_cast<int>(queue.size_for_consumer());
+  return true;
+}
+
+// Downstream of capture every queue blocks its producer (in live mode too): the drop
+// policy acts at capture only, so a slow stage backs the queues up until capture drops.
+void Pipeline::forward(Queue &queue, FramePtr &frame) {
+  frame->enqueued = Clock::now();
+  if (!queue.push(frame, abort_)) frame.reset();  // aborting: discard
+}
+
+void Pipeline::capture_loop(FrameSource source) {
+  Queue &out = queues_[kFrontend];
+  const Clock::time_point start = Clock::now();
+  std::uint64_t sequence = 0;
+  std::uint32_t dropped_run = 0;
+  while (!stop_.load(std::memory_order_relaxed)) {
+    if (config_.input_rate_hz > 0.0) {
+      const auto due = start + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(
+                                   static_cast<double>(sequence) / config_.input_rate_hz));
+      // Sleep in slices so that stop() is noticed at low rates too.
+      while (Clock::now() < due && !stop_.load(std::memory_order_relaxed)) {
+        std::this_thread::sleep_until(std::min(due, Clock::now() + std::chrono::milliseconds(20)));
+      }
+      if (stop_.load(std::memory_order_relaxed)) break;
+    }
+    busy(0, true);
+    const Clock::time_point before = Clock::now();
+    FramePtr frame;
+    try {
+      frame = source();
+    } catch (const std::exception &error) {
+      fail(capture_error_, std::string("input: ") + error.what());
+    }
+    busy(0, false);
+    if (!frame) break;
+    frame->captured = Clock::now();
+    frame->sequence = ++sequence;
+    frame->timings.stage_ms[kRead] = ms_between(before, frame->captured);
+    frame->dropped_before = dropped_run;
+    frame->enqueued = frame->captured;
+    captured_.fetch_add(1, std::memory_order_relaxed);
+    if (config_.mode == Mode::kLive) {
+      if (!out.try_push(frame)) {
+        ++dropped_run;
+        dropped_.fetch_add(1, std::memory_order_relaxed);
+        continue;
+      }
+    } else if (!out.push(frame, abort_)) {
+      break;
+    }
+    dropped_run = 0;
+  }
+  out.close();
+}
+
+void Pipeline::frontend_loop() {
+  stereo::ScanReconstructor frontend(scan_config_);
+  FramePtr frame;
+  while (take(queues_[kFrontend], kFrontend, frame)) {
+    busy(1, true);
+    if (!frame->skipped() && !frontend.accepts(frame->image)) {
+      frame->error = "not an 8-bit grey image of the camera size";
+    }
+    if (!frame->skipped()) {
+      StepClock clock(*frame);
+      frontend.unwarp(frame->image);
+      clock.lap(kUnwarp);
+      frontend.detect_edges();
+      clock.lap(kCanny);
+      frontend.select_edges();
+      clock.lap(kEdges);
+      frontend.swap_lobes(frame->inner, frame->outer);
+    }
+    frame->image.release();
+    busy(1, false);
+    forward(queues_[kStereo], frame);
+  }
+  queues_[kStereo].close();
+}
+
+void Pipeline::stereo_loop() {
+  stereo::ScanReconstructor matcher(scan_config_);
+  FramePtr frame;
+  while (take(queues_[kStereo], kStereo, frame)) {
+    busy(2, true);
+    if (!frame->skipped()) {
+      StepClock clock(*frame);
+      matcher.swap_lobes(frame->inner, frame->outer);
+      matcher.match();
+      clock.lap(kMatch);
+      matcher.triangulate(frame->scan);
+      clock.lap(kTriangulation);
+    }
+    frame->inner = {};  // the lobes are not needed downstream
+    frame->outer = {};
+    busy(2, false);
+    forward(queues_[kSlamQueue], frame);
+  }
+  queues_[kSlamQueue].close();
+}
+
+void Pipeline::slam_loop() {
+  Clock::time_point last_map = Clock::time_point::min();
+  FramePtr frame;
+  while (take(queues_[kSlamQueue], kSlamQueue, frame)) {
+    busy(3, true);
+    StepClock clock(*frame);
+    frame->estimate = slam_.process(scan_points(frame->scan), frame->T_odom_base);
+    clock.lap(kSlam);
+    if (frame->estimate.integrated) {
+      const Clock::time_point now = Clock::now();
+      const bool due = config_.map_period_s > 0.0 &&
+                       (last_map == Clock::time_point::min() ||
+                        now - last_map >= std::chrono::duration<double>(config_.map_period_s));
+      if (config_.map_every_integration || due) {
+        frame->map = std::make_shared<const std::vector<slam::MapPoint>>(slam_.map().points());
+        last_map = now;
+      }
+    }
+    busy(3, false);
+    forward(queues_[kPublish], frame);
+  }
+  queues_[kPublish].close();
+}
+
+void Pipeline::emit_profile(const Profiler &profiler) {
+  if (!sinks_.profile) return;
+  ProfileSnapshot snapshot = profiler.snapshot();
+  snapshot.frames_captured = frames_captured();
+  snapshot.frames_dropped = frames_dropped();
+  snapshot.frames_out = frames_out();
+  for (std::size_t q = 0; q < queues_.size(); ++q)
+    snapshot.queue_capacity[q] = static_cast<int>(queues_[q].capacity());
+  sinks_.profile(snapshot);
+}
+
+void Pipeline::publish_loop() {
+  Queue &in = queues_[kPublish];
+  Profiler profiler(config_.profile_window);
+  const auto period = std::chrono::duration_cast<Clock::duration>(
+      std::chrono::duration<double>(config_.profile_period_s > 0.0 ? config_.profile_period_s : 1.0));
+  Clock::time_point next_profile = Clock::now() + period;
+  for (;;) {
+    FramePtr frame;
+    const PopStatus status = in.pop(frame, next_profile);
+    if (status == PopStatus::kClosed) break;
+    if (status == PopStatus::kItem && !abort_.load(std::memory_order_relaxed)) {
+      const Clock::time_point now = Clock::now();
+      frame->timings.wait_ms[kPublish] = ms_between(frame->enqueued, now);
+      frame->timings.queue_depth[kPublish] = static_cast<int>(in.size_for_consumer());
+      frame->timings.latency_ms = ms_between(frame->captured, now);
+      profiler.add(frame->timings);
+      busy(4, true);
+      try {
+        if (sinks_.frame) sinks_.frame(*frame);
+      } catch (const std::exception &error) {
+        fail(publish_error_, std::string("output: ") + error.what());
+      }
+      busy(4, false);
+      out_.fetch_add(1, std::memory_order_relaxed);
+    }
+    if (Clock::now() >= next_profile) {
+      next_profile += period;
+      try {
+        emit_profile(profiler);
+      } catch (const std::exception &error) {
+        fail(publish_error_, std::string("profile output: ") + error.what());
+      }
+    }
+  }
+  try {
+    emit_profile(profiler);
+  } catch (const std::exception &error) {
+    fail(publish_error_, std::string("profile output: ") + error.what());
+  }
+  finished_.store(true, std::memory_order_release);
+}
+
+}  // namespace omnislam::pipeline

@@ -1,0 +1,199 @@
+#include <catch2/catch.hpp>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <vector>
+
+#include <zlib.h>
+
+#include "omnislam/io/snapshot.hpp"
+
+namespace fs = std::filesystem;
+using omnislam::io::Snapshot;
+using omnislam::io::SnapshotError;
+
+namespace {
+
+fs::path scratch(const std::string &name) {
+  const fs::path dir = fs::temp_directory_path() / "omnislam-test-snapshot" / name;
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  return dir;
+}
+
+Snapshot example() {
+  Snapshot s;
+  s.config_hash = 0x0123456789abcdefull;
+  s.t_s = 12.5;
+  s.T_map_base = Eigen::Translation2d(1.25, -0.5) * Eigen::Rotation2Dd(0.75);
+  s.covariance << 1e-4, 2e-5, 0, 2e-5, 3e-4, 1e-6, 0, 1e-6, 5e-5;
+  s.counters = {125, 120, 5, 2, 7};
+  s.map_integrations = 120;
+  for (int i = 0; i < 50; ++i) s.points.push_back({{0.1 * i, -0.05 * i}, 1 + i % 7, i});
+  return s;
+}
+
+std::vector<std::uint8_t> file_bytes(const fs::path &file) {
+  std::ifstream in(file, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+void write_bytes(const fs::path &file, const std::vector<std::uint8_t> &bytes) {
+  std::ofstream(file, std::ios::binary)
+      .write(reinterpret_cast<const char *>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
+}
+
+}  // namespace
+
+TEST_CASE("snapshot: written atomically and read back exactly", "[io][snapshot]") {
+  const fs::path dir = scratch("roundtrip");
+  const Snapshot written = example();
+  omnislam::io::write_snapshot(dir / "state.snap", written);
+  // 24-byte header + 168-byte fixed payload + 24 bytes per point; no temporary left over.
+  CHECK(fs::file_size(dir / "state.snap") == 24 + 168 + 24 * 50);
+  CHECK(std::distance(fs::directory_iterator(dir), fs::directory_iterator()) == 1);
+
+  const Snapshot read = omnislam::io::read_snapshot(dir / "state.snap");
+  CHECK(read.config_hash == 0x0123456789abcdefull);
+  CHECK(read.t_s == 12.5);
+  CHECK(read.T_map_base.translation().x() == 1.25);
+  CHECK(read.T_map_base.translation().y() == -0.5);
+  CHECK(std::atan2(read.T_map_base.linear()(1, 0), read.T_map_base.linear()(0, 0)) ==
+        Approx(0.75).epsilon(1e-15));
+  CHECK(read.covariance == written.covariance);
+  CHECK(read.counters.frames == 125);
+  CHECK(read.counters.integrated == 120);
+  CHECK(read.counters.not_integrated == 5);
+  CHECK(read.counters.skipped == 2);
+  CHECK(read.counters.dropped == 7);
+  CHECK(read.map_integrations == 120);
+  REQUIRE(read.points.size() == 50);
+  CHECK(read.points[49].position_m.x() == written.points[49].position_m.x());
+  CHECK(read.points[49].position_m.y() == written.points[49].position_m.y());
+  CHECK(read.points[49].hits == 1 + 49 % 7);
+  CHECK(read.points[49].first_seen == 49);
+
+  // Replacing an existing snapshot keeps one file holding the new state.
+  Snapshot next = written;
+  next.counters.frames = 126;
+  next.points.resize(3);
+  omnislam::io::write_snapshot(dir / "state.snap", next);
+  CHECK(omnislam::io::read_snapshot(dir / "state.snap").counters.frames == 126);
+  CHECK(omnislam::io::read_snapshot(dir / "state.snap").points.size() == 3);
+  CHECK(std::distance(fs::directory_iterator(dir), fs::directory_iterator()) == 1);
+}
+
+TEST_CASE("snapshot: an empty map and the default pose round-trip", "[io][snapshot]") {
+  const fs::path dir = scratch("empty");
+  omnislam::io::write_snapshot(dir / "empty.snap", Snapshot{});
+  const Snapshot read = omnislam::io::read_snapshot(dir / "empty.snap");
+  CHECK(read.points.empty());
+  CHECK(read.T_map_base.isApprox(Eigen::Isometry2d::Identity()));
+  CHECK(read.counters.frames == 0);
+}
+
+TEST_CASE("snapshot: truncation, bit flips, other versions and bad values are rejected by name",
+          "[io][snapshot]") {
+  const std::vector<std::uint8_t> good = omnislam::io::encode_snapshot(example());
+  // Every truncation is caught, whatever the length.
+  for (std::size_t length = 0; length < good.size(); ++length) {
+    const std::vector<std::uint8_t> cut(good.begin(), good.begin() + static_cast<long>(length));
+    CHECK_THROWS_AS(omnislam::io::decode_snapshot(cut, "cut.snap"), SnapshotError);
+  }
+  const std::vector<std::uint8_t> header_only(good.begin(), good.begin() + 30);
+  CHECK_THROWS_WITH(omnislam::io::decode_snapshot(header_only, "cut.snap"),
+                    Catch::Contains("cut.snap: truncated") && Catch::Contains("1368 payload bytes") &&
+                        Catch::Contains("has 6"));
+  // A flipped bit anywhere after the magic fails the checksum (or, in the size field, the length).
+  for (std::size_t i = 8; i < good.size(); i += 37) {
+    std::vector<std::uint8_t> flipped = good;
+    flipped[i] ^= 0x10;
+    CHECK_THROWS_AS(omnislam::io::decode_snapshot(flipped, "flip.snap"), SnapshotError);
+  }
+  std::vector<std::uint8_t> flipped = good;
+  flipped[100] ^= 0x01;
+  CHECK_THROWS_WITH(omnislam::io::decode_snapshot(flipped, "flip.snap"),
+                    Catch::Equals("flip.snap: checksum mismatch (the file is corrupt)"));
+  std::vector<std::uint8_t> magic = good;
+  magic[0] = 'X';
+  CHECK_THROWS_WITH(omnislam::io::decode_snapshot(magic, "other.bin"), Catch::Contains("bad magic"));
+  std::vector<std::uint8_t> longer = good;
+  longer.push_back(0);
+  CHECK_THROWS_WITH(omnislam::io::decode_snapshot(longer, "long.snap"), Catch::Contains("trailing bytes"));
+}
+
+TEST_CASE("snapshot: a future version or impossible values are named even with a valid checksum",
+          "[io][snapshot]") {
+  // A version-2 file (as a newer build would write it) has a valid CRC of its own.
+  std::vector<std::uint8_t> v2 = omnislam::io::encode_snapshot(example());
+  v2[8] = 2;
+  uLong crc = crc32(0L, Z_NULL, 0);
+  crc = crc32(crc, v2.data() + 8, 12);
+  crc = crc32(crc, v2.data() + 24, static_cast<uInt>(v2.size() - 24));
+  for (int i = 0; i < 4; ++i)
+    v2[20 + static_cast<std::size_t>(i)] = static_cast<std::uint8_t>(crc >> (8 * i));
+  CHECK_THROWS_WITH(omnislam::io::decode_snapshot(v2, "v2.snap"),
+                    Catch::Equals("v2.snap: unsupported snapshot version 2 (this build reads version 1)"));
+
+  Snapshot bad = example();
+  bad.points[3].hits = 0;
+  CHECK_THROWS_WITH(omnislam::io::decode_snapshot(omnislam::io::encode_snapshot(bad), "hits.snap"),
+                    Catch::Contains("map point 3 has hits 0"));
+  bad = example();
+  bad.points[4].first_seen = 121;
+  CHECK_THROWS_WITH(omnislam::io::decode_snapshot(omnislam::io::encode_snapshot(bad), "age.snap"),
+                    Catch::Contains("first_seen 121 (map_integrations 120)"));
+  bad = example();
+  bad.t_s = std::nan("");
+  CHECK_THROWS_WITH(omnislam::io::decode_snapshot(omnislam::io::encode_snapshot(bad), "nan.snap"),
+                    Catch::Contains("t_s is not a finite number"));
+}
+
+TEST_CASE("snapshot: a corrupt file is moved aside as .corrupt-N; resume starts fresh or refuses",
+          "[io][snapshot]") {
+  const fs::path dir = scratch("resume");
+  const fs::path file = dir / "state.snap";
+  using omnislam::io::CorruptSnapshotPolicy;
+
+  auto fresh = omnislam::io::resume_from_snapshot(file, CorruptSnapshotPolicy::kStartFresh);
+  CHECK_FALSE(fresh.snapshot);
+  CHECK_THAT(fresh.message, Catch::Contains("no snapshot") && Catch::Contains("starting a new map"));
+
+  omnislam::io::write_snapshot(file, example());
+  auto resumed = omnislam::io::resume_from_snapshot(file, CorruptSnapshotPolicy::kRefuse);
+  REQUIRE(resumed.snapshot);
+  CHECK(resumed.snapshot->points.size() == 50);
+  CHECK_THAT(resumed.message, Catch::Contains("50 map points, 125 frames"));
+
+  std::vector<std::uint8_t> bytes = file_bytes(file);
+  bytes.resize(bytes.size() - 10);
+  write_bytes(file, bytes);
+  CHECK_THROWS_WITH(omnislam::io::resume_from_snapshot(file, CorruptSnapshotPolicy::kRefuse),
+                    Catch::Contains("truncated") && Catch::Contains("refusing to start"));
+  CHECK(fs::exists(file));  // an operator decides what happens to it
+
+  auto moved = omnislam::io::resume_from_snapshot(file, CorruptSnapshotPolicy::kStartFresh);
+  CHECK_FALSE(moved.snapshot);
+  CHECK(moved.moved_aside_to == dir / "state.snap.corrupt-1");
+  CHECK(fs::file_size(dir / "state.snap.corrupt-1") == bytes.size());
+  CHECK_FALSE(fs::exists(file));
+  CHECK_THAT(moved.message, Catch::Contains("state.snap.corrupt-1") && Catch::Contains("starting a new map"));
+
+  write_bytes(file, {1, 2, 3});
+  CHECK(omnislam::io::move_aside(file) == dir / "state.snap.corrupt-2");
+}
+
+TEST_CASE("snapshot: writing into a missing directory fails with the path", "[io][snapshot]") {
+  CHECK_THROWS_WITH(omnislam::io::write_snapshot("/nonexistent-omnislam/state.snap", example()),
+                    Catch::Contains("/nonexistent-omnislam/state.snap.tmp"));
+}
+
+TEST_CASE("config file hash: FNV-1a of the bytes", "[io][snapshot]") {
+  const fs::path dir = scratch("hash");
+  std::ofstream(dir / "empty.yaml").flush();
+  { std::ofstream(dir / "a.yaml") << "a"; }
+  CHECK(omnislam::io::config_file_hash("") == 0);
+  CHECK(omnislam::io::config_file_hash(dir / "empty.yaml") == 0xcbf29ce484222325ull);
+  CHECK(omnislam::io::config_file_hash(dir / "a.yaml") == 0xaf63dc4c8601ec8cull);
+}

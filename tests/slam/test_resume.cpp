@@ -1,0 +1,141 @@
+#include <algorithm>
+#include <catch2/catch.hpp>
+#include <random>
+#include <vector>
+
+#include "omnislam/slam/odometry_noise.hpp"
+#include "omnislam/slam/slam.hpp"
+#include "synthetic_room.hpp"
+
+// Resuming from a saved state and localization on a fixed map (the service's persistence).
+using omnislam::slam::MapPoint;
+using omnislam::slam::Slam;
+using omnislam::slam::SlamConfig;
+using omnislam::test::pose;
+
+namespace {
+
+// Through the L-room and back along its long side, 0.2 m steps, facing the way it goes.
+std::vector<Eigen::Isometry2d> tour() {
+  const std::vector<Eigen::Vector2d> corners = {{0, 0}, {5, 0}, {5, 0.6}, {1.5, 0.6}, {1.5, 2.8}, {0, 2.8}};
+  std::vector<Eigen::Isometry2d> truth;
+  for (std::size_t c = 0; c + 1 < corners.size(); ++c) {
+    const Eigen::Vector2d a = corners[c], b = corners[c + 1];
+    const int steps = std::max(1, static_cast<int>(std::round((b - a).norm() / 0.2)));
+    for (int s = 0; s < steps; ++s) {
+      const Eigen::Vector2d p = a + (b - a) * (static_cast<double>(s) / steps);
+      truth.push_back(pose(p.x(), p.y(), std::atan2(b.y() - a.y(), b.x() - a.x())));
+    }
+  }
+  return truth;
+}
+
+double position_error(const Eigen::Isometry2d &estimate, const Eigen::Isometry2d &truth) {
+  return (estimate.translation() - truth.translation()).norm();
+}
+
+struct Track {
+  double max_error_m = 0.0;
+  double odometry_max_error_m = 0.0;
+  int accepted = 0;
+  Eigen::Isometry2d last_pose = Eigen::Isometry2d::Identity();
+  Eigen::Matrix3d last_covariance = Eigen::Matrix3d::Zero();
+};
+
+// Feeds frames [first, last) of `truth` (map frame = truth[0] = identity) with noisy odometry.
+Track run(Slam &slam, const std::vector<Eigen::Isometry2d> &truth, std::size_t first, std::size_t last,
+          std::uint64_t seed) {
+  const auto walls = omnislam::test::l_room();
+  const auto odometry = omnislam::slam::apply_thesis_odometry_noise(truth, seed);
+  std::mt19937_64 rng(seed);
+  Track track;
+  for (std::size_t i = first; i < last; ++i) {
+    const auto estimate = slam.process(omnislam::test::scan_from(walls, truth[i], rng), odometry[i]);
+    track.max_error_m = std::max(track.max_error_m, position_error(estimate.T_map_base, truth[i]));
+    const Eigen::Isometry2d odometry_map = odometry[first].inverse() * odometry[i];
+    track.odometry_max_error_m =
+        std::max(track.odometry_max_error_m, position_error(truth[first] * odometry_map, truth[i]));
+    track.accepted += estimate.integrated ? 1 : 0;
+    track.last_pose = estimate.T_map_base;
+    track.last_covariance = estimate.covariance;
+  }
+  return track;
+}
+
+bool same_points(const std::vector<MapPoint> &a, const std::vector<MapPoint> &b) {
+  return std::equal(a.begin(), a.end(), b.begin(), b.end(), [](const MapPoint &p, const MapPoint &q) {
+    return p.position_m == q.position_m && p.hits == q.hits && p.first_seen == q.first_seen;
+  });
+}
+
+}  // namespace
+
+TEST_CASE("localization only: tracks the pose on a saved map and never changes it", "[slam][resume]") {
+  const auto truth = tour();
+  Slam mapping;
+  (void)run(mapping, truth, 0, truth.size(), 1);
+  const std::vector<MapPoint> saved = mapping.map().points();
+  const int integrations = mapping.map().integrations();
+  REQUIRE(saved.size() > 200);
+
+  SlamConfig config;
+  config.localization_only = true;
+  Slam localizer(config);
+  localizer.resume(saved, integrations, Eigen::Isometry2d::Identity(), Eigen::Matrix3d::Zero());
+  // Other odometry noise and other scan noise than the mapping run.
+  const Track track = run(localizer, truth, 0, truth.size(), 9);
+  INFO("max error " << track.max_error_m << " m, odometry alone " << track.odometry_max_error_m
+                    << " m, accepted " << track.accepted << "/" << truth.size());
+  CHECK(track.max_error_m < 0.05);
+  CHECK(track.max_error_m < 0.5 * track.odometry_max_error_m);
+  CHECK(track.accepted >= static_cast<int>(0.9 * truth.size()));
+  CHECK(localizer.map().integrations() == integrations);
+  CHECK(same_points(localizer.map().points(), saved));
+}
+
+TEST_CASE("localization only without a map registers scan to scan and builds nothing", "[slam][resume]") {
+  SlamConfig config;
+  config.localization_only = true;
+  Slam slam(config);
+  const auto walls = omnislam::test::l_room();
+  std::mt19937_64 rng(3);
+  // Odometry 3 cm short of the true 0.2 m step.
+  const auto first = slam.process(omnislam::test::scan_from(walls, pose(0, 0, 0), rng), pose(2, 1, 0));
+  const auto second = slam.process(omnislam::test::scan_from(walls, pose(0.2, 0, 0), rng), pose(2.17, 1, 0));
+  CHECK_FALSE(first.integrated);
+  CHECK(first.T_map_base.isApprox(Eigen::Isometry2d::Identity()));
+  CHECK(second.integrated);
+  CHECK(second.attempt == omnislam::slam::Attempt::kPreviousForward);
+  CHECK((second.T_map_base.translation() - Eigen::Vector2d(0.2, 0.0)).norm() < 0.01);
+  CHECK(slam.map().empty());
+  CHECK(slam.map().integrations() == 0);
+}
+
+TEST_CASE("resume: a restarted SLAM continues the map and the trajectory where they were", "[slam][resume]") {
+  const auto truth = tour();
+  const std::size_t half = truth.size() / 2;
+  Slam before;
+  const Track first_half = run(before, truth, 0, half, 4);
+  const std::vector<MapPoint> saved = before.map().points();
+  const int integrations = before.map().integrations();
+
+  // The restarted instance sees the last frame's place again (the robot stood still), with
+  // its odometry counting from wherever the restarted odometry starts.
+  Slam after;
+  after.resume(saved, integrations, first_half.last_pose, first_half.last_covariance);
+  const Track second_half = run(after, truth, half - 1, truth.size(), 5);
+  INFO("first half max " << first_half.max_error_m << " m, second half max " << second_half.max_error_m
+                         << " m, odometry alone " << second_half.odometry_max_error_m << " m");
+  CHECK(first_half.max_error_m < 0.05);
+  CHECK(second_half.max_error_m < 0.05);
+  CHECK(second_half.max_error_m < 0.5 * second_half.odometry_max_error_m);
+  CHECK(second_half.accepted >= static_cast<int>(0.9 * (truth.size() - half + 1)));
+  // The map kept growing from the saved one: more integrations, and points of the second
+  // half (the corridor beyond x = 1.5 m, y > 1.5 m) that the first half never saw.
+  CHECK(after.map().integrations() > integrations + static_cast<int>(0.9 * (truth.size() - half)));
+  const auto upper = [](const std::vector<MapPoint> &points) {
+    return std::count_if(points.begin(), points.end(),
+                         [](const MapPoint &p) { return p.position_m.y() > 3.5 && p.position_m.x() < 0.5; });
+  };
+  CHECK(upper(after.map().points()) > upper(saved) + 10);
+}
