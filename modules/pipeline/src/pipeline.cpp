@@ -3,6 +3,8 @@
 #include <exception>
 #include <utility>
 
+#include <opencv2/core/utility.hpp>
+
 #include "omnislam/stereo/scan_reconstructor.hpp"
 
 namespace omnislam::pipeline {
@@ -55,6 +57,10 @@ Pipeline::~Pipeline() {
 void Pipeline::start(FrameSource source) {
   if (started_) throw std::logic_error("Pipeline::start called twice");
   started_ = true;
+  // One thread per stage is the parallelism: OpenCV's own worker pool would only compete
+  // with the stages for the cores (and, uninstrumented, hides its work from TSan). Canny and
+  // remap give the same pixels either way.
+  cv::setNumThreads(0);
   threads_[0] =
       std::thread([this, source = std::move(source)]() mutable { capture_loop(std::move(source)); });
   threads_[1] = std::thread([this] { frontend_loop(); });
