@@ -41,6 +41,21 @@ namespace {
 
 using detail::YamlSection;
 
+template <typename Enum>
+void read_choice(YamlSection &section, const char *key, Enum &value,
+                 std::initializer_list<std::pair<const char *, Enum>> choices, const char *message) {
+  std::string text;
+  section.read(key, text);
+  if (text.empty()) return;
+  for (const auto &[name, choice] : choices) {
+    if (text == name) {
+      value = choice;
+      return;
+    }
+  }
+  section.fail(key, message);
+}
+
 void read_vision(YamlSection &section, vision::VisionConfig &vision) {
   vision::CannyConfig &canny = vision.canny;
   section.read("sigma_px", canny.sigma_px);
@@ -79,46 +94,18 @@ void read_stereo(YamlSection &section, stereo::StereoConfig &stereo) {
   section.read("near_cutoff_m", stereo.near_cutoff_m);
   section.read("far_cutoff_m", stereo.far_cutoff_m);
   section.read("one_point_per_degree", stereo.one_point_per_degree);
-  std::string subpixel;
-  section.read("subpixel", subpixel);
-  if (subpixel.empty()) {
-  } else if (subpixel == "none") {
-    stereo.subpixel = stereo::SubpixelMethod::kNone;
-  } else if (subpixel == "edge_peak") {
-    stereo.subpixel = stereo::SubpixelMethod::kEdgePeak;
-  } else if (subpixel == "cost_curve") {
-    stereo.subpixel = stereo::SubpixelMethod::kCostCurve;
-  } else {
-    section.fail("subpixel", "must be none, edge_peak or cost_curve");
-  }
-  std::string triangulation;
-  section.read("triangulation", triangulation);
-  if (triangulation.empty()) {
-  } else if (triangulation == "exact") {
-    stereo.triangulation = stereo::TriangulationMethod::kExact;
-  } else if (triangulation == "table") {
-    stereo.triangulation = stereo::TriangulationMethod::kTable;
-  } else {
-    section.fail("triangulation", "must be exact or table");
-  }
+  read_choice(section, "subpixel", stereo.subpixel,
+              {{"none", stereo::SubpixelMethod::kNone},
+               {"edge_peak", stereo::SubpixelMethod::kEdgePeak},
+               {"cost_curve", stereo::SubpixelMethod::kCostCurve}},
+              "must be none, edge_peak or cost_curve");
+  read_choice(
+      section, "triangulation", stereo.triangulation,
+      {{"exact", stereo::TriangulationMethod::kExact}, {"table", stereo::TriangulationMethod::kTable}},
+      "must be exact or table");
   if (!(stereo.max_range_m > stereo.min_range_m)) section.fail("max_range_m", "must exceed min_range_m");
   if (!(stereo.far_cutoff_m > stereo.near_cutoff_m))
     section.fail("far_cutoff_m", "must exceed near_cutoff_m");
-}
-
-template <typename Enum>
-void read_choice(YamlSection &section, const char *key, Enum &value,
-                 std::initializer_list<std::pair<const char *, Enum>> choices, const char *message) {
-  std::string text;
-  section.read(key, text);
-  if (text.empty()) return;
-  for (const auto &[name, choice] : choices) {
-    if (text == name) {
-      value = choice;
-      return;
-    }
-  }
-  section.fail(key, message);
 }
 
 void read_slam(YamlSection &section, slam::SlamConfig &slam) {
