@@ -18,6 +18,7 @@
 #include "omnislam/io/dataset.hpp"
 #include "omnislam/io/ground_truth_files.hpp"
 #include "omnislam/io/image_file.hpp"
+#include "omnislam/io/poses.hpp"
 #include "omnislam/slam/evaluation.hpp"
 #include "omnislam/slam/trimmed_icp.hpp"
 #include "omnislam/stereo/scan_reconstructor.hpp"
@@ -25,19 +26,6 @@
 namespace {
 
 using omnislam::slam::Points2;
-
-Eigen::Isometry2d planar(const omnislam::io::StampedPose &p) {
-  Eigen::Isometry2d T = Eigen::Isometry2d::Identity();
-  T.linear() = Eigen::Rotation2Dd(p.yaw_rad()).toRotationMatrix();
-  T.translation() = Eigen::Vector2d(p.x_m, p.y_m);
-  return T;
-}
-
-std::vector<Eigen::Isometry2d> relative(const std::vector<omnislam::io::StampedPose> &poses) {
-  std::vector<Eigen::Isometry2d> out;
-  for (const auto &p : poses) out.push_back(planar(poses.front()).inverse() * planar(p));
-  return out;
-}
 
 pcl::PointCloud<pcl::PointXYZ>::Ptr to_cloud(const Points2 &points) {
   auto cloud = pcl::make_shared<pcl::PointCloud<pcl::PointXYZ>>();
@@ -100,8 +88,10 @@ int main(int argc, char **argv) {
       for (const auto &p : scan.points) points.emplace_back(p.x_m, p.y_m);
       scans.push_back(std::move(points));
     }
-    const auto truth = relative(omnislam::io::read_tum_file(info.groundtruth));
-    const auto odometry = relative(omnislam::io::read_tum_file(info.odometry));
+    const auto truth = omnislam::io::relative_to_first(
+        omnislam::io::to_isometries(omnislam::io::read_tum_file(info.groundtruth)));
+    const auto odometry = omnislam::io::relative_to_first(
+        omnislam::io::to_isometries(omnislam::io::read_tum_file(info.odometry)));
     std::printf("bench_registration %s: %zu consecutive scan pairs, initial guess = odometry step\n", argv[1],
                 scans.size() - 1);
     std::printf("  %-34s %10s %10s %12s %12s\n", "method", "median ms", "p99 ms", "ATE max mm", "final mm");

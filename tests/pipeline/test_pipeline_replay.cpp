@@ -8,6 +8,7 @@
 #include "omnislam/io/dataset.hpp"
 #include "omnislam/io/ground_truth_files.hpp"
 #include "omnislam/io/image_file.hpp"
+#include "omnislam/io/poses.hpp"
 #include "omnislam/pipeline/pipeline.hpp"
 #include "omnislam/stereo/scan_reconstructor.hpp"
 
@@ -20,17 +21,6 @@ using namespace std::chrono_literals;
 namespace {
 
 constexpr int kFrames = 12;  // enough for registrations, map fusion and pruning
-
-std::vector<Eigen::Isometry2d> poses(const std::vector<io::StampedPose> &records) {
-  std::vector<Eigen::Isometry2d> out;
-  for (const io::StampedPose &p : records) {
-    Eigen::Isometry2d T = Eigen::Isometry2d::Identity();
-    T.linear() = Eigen::Rotation2Dd(p.yaw_rad()).toRotationMatrix();
-    T.translation() = Eigen::Vector2d(p.x_m, p.y_m);
-    out.push_back(T);
-  }
-  return out;
-}
 
 struct Input {
   io::DatasetInfo info;
@@ -49,8 +39,8 @@ const Input &input() {
     in.info = io::read_dataset_info(std::filesystem::path(OMNISLAM_DEFAULT_DATASETS) / "sim-room-37");
     in.scan.camera = in.info.camera;
     in.scan.camera_height_m = in.info.camera_height_m;
-    in.odometry = poses(io::read_tum_file(in.info.odometry));
-    in.ground_truth = poses(io::read_tum_file(in.info.groundtruth));
+    in.odometry = io::to_isometries(io::read_tum_file(in.info.odometry));
+    in.ground_truth = io::to_isometries(io::read_tum_file(in.info.groundtruth));
     for (int i = 1; i <= kFrames; ++i)
       in.images.push_back(io::read_camera_image(in.info.image(i), in.scan.camera));
     return in;

@@ -8,9 +8,9 @@
 #include <string>
 
 #include "omnislam/io/dataset.hpp"
+#include "omnislam/io/poses.hpp"
 #include "omnislam/io/run_files.hpp"
 #include "omnislam/slam/evaluation.hpp"
-#include "poses.hpp"
 
 namespace omnislam::app {
 namespace {
@@ -31,9 +31,9 @@ void evaluate(const std::filesystem::path &run_dir, const std::filesystem::path 
   const io::DatasetInfo info = io::read_dataset_info(dataset_dir);
   if (info.groundtruth.empty())
     throw std::runtime_error(dataset_dir.string() + ": no groundtruth in dataset.yaml");
-  auto truth = relative_to_first(to_isometries(io::read_tum_file(info.groundtruth)));
-  auto odometry = relative_to_first(to_isometries(io::read_tum_file(info.odometry)));
-  const auto estimate = to_isometries(io::read_tum_file(run_dir / "trajectory.tum"));
+  auto truth = io::relative_to_first(io::to_isometries(io::read_tum_file(info.groundtruth)));
+  auto odometry = io::relative_to_first(io::to_isometries(io::read_tum_file(info.odometry)));
+  const auto estimate = io::to_isometries(io::read_tum_file(run_dir / "trajectory.tum"));
   if (estimate.size() > truth.size()) {
     throw std::runtime_error((run_dir / "trajectory.tum").string() + " has " +
                              std::to_string(estimate.size()) + " poses but the ground truth only " +

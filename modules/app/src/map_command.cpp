@@ -9,9 +9,9 @@
 #include <numbers>
 #include <string>
 
+#include "omnislam/io/poses.hpp"
 #include "omnislam/io/run_files.hpp"
 #include "omnislam/io/snapshot.hpp"
-#include "poses.hpp"
 
 namespace omnislam::app {
 namespace {
@@ -59,7 +59,7 @@ void save(const std::filesystem::path &run_dir, const std::filesystem::path &fil
   const auto trajectory = io::read_tum_file(run_dir / "trajectory.tum");
   if (trajectory.empty()) throw std::runtime_error((run_dir / "trajectory.tum").string() + ": no poses");
   s.t_s = trajectory.back().t_s;
-  s.T_map_base = to_isometry(trajectory.back());
+  s.T_map_base = io::to_isometry(trajectory.back());
   s.covariance = last_covariance(run_dir / "covariance.csv");
   s.counters.frames = trajectory.size();
   if (std::ifstream summary_file{run_dir / "summary.json"}) {
@@ -87,7 +87,7 @@ void load(const std::filesystem::path &file, const std::filesystem::path &out_di
   for (const slam::MapPoint &p : s.points) records.push_back({p.position_m.x(), p.position_m.y(), p.hits});
   io::write_map_csv(out_dir / "map.csv", records);
   io::write_map_ply(out_dir / "map.ply", records);
-  io::write_tum_file(out_dir / "pose.tum", {to_stamped(s.t_s, s.T_map_base)});
+  io::write_tum_file(out_dir / "pose.tum", {io::to_stamped(s.t_s, s.T_map_base)});
   std::printf("wrote %zu map points to %s (map.csv, map.ply) and the pose to pose.tum\n", records.size(),
               out_dir.c_str());
 }

@@ -10,9 +10,9 @@
 #include "frame_record.hpp"
 #include "omnislam/io/config.hpp"
 #include "omnislam/io/dataset.hpp"
+#include "omnislam/io/poses.hpp"
 #include "omnislam/pipeline/pipeline.hpp"
 #include "omnislam/slam/odometry_noise.hpp"
-#include "poses.hpp"
 #include "run_outputs.hpp"
 
 namespace omnislam::app {
@@ -32,11 +32,11 @@ struct ReplayOptions {
 std::vector<Eigen::Isometry2d> load_odometry(const io::DatasetInfo &info, const ReplayOptions &options) {
   if (!options.odometry_file.empty()) {
     const std::filesystem::path file = options.odometry_file;
-    return to_isometries(file.extension() == ".txt" ? io::read_thesis_odometry(file)
-                                                    : io::read_tum_file(file));
+    return io::to_isometries(file.extension() == ".txt" ? io::read_thesis_odometry(file)
+                                                        : io::read_tum_file(file));
   }
-  if (options.odometry_noise.empty()) return to_isometries(io::read_tum_file(info.odometry));
-  return slam::apply_thesis_odometry_noise(to_isometries(io::read_tum_file(info.odometry_exact)),
+  if (options.odometry_noise.empty()) return io::to_isometries(io::read_tum_file(info.odometry));
+  return slam::apply_thesis_odometry_noise(io::to_isometries(io::read_tum_file(info.odometry_exact)),
                                            options.seed);
 }
 
@@ -52,10 +52,10 @@ void run_replay(const ReplayOptions &options) {
                              std::to_string(info.frames) + " frames");
   }
   RunRecord run;
-  run.odometry_map = relative_to_first(odometry);
+  run.odometry_map = io::relative_to_first(odometry);
   run.odometry_map.resize(static_cast<std::size_t>(info.frames));
   if (!info.groundtruth.empty()) {
-    run.ground_truth = relative_to_first(to_isometries(io::read_tum_file(info.groundtruth)));
+    run.ground_truth = io::relative_to_first(io::to_isometries(io::read_tum_file(info.groundtruth)));
     run.ground_truth.resize(static_cast<std::size_t>(info.frames));
   }
   OutputWriter writer(options.out_dir);

@@ -8,10 +8,10 @@
 #include <sstream>
 #include <string>
 
+#include "omnislam/io/poses.hpp"
 #include "omnislam/io/run_files.hpp"
 #include "omnislam/pipeline/profiler.hpp"
 #include "omnislam/slam/evaluation.hpp"
-#include "poses.hpp"
 
 namespace omnislam::app {
 namespace {
@@ -164,7 +164,7 @@ void OutputWriter::write_all(const RunRecord &run, const slam::PointMap &map,
   std::vector<io::StampedPose> trajectory;
   std::vector<Eigen::Isometry2d> estimate;
   for (const FrameRecord &f : run.frames) {
-    trajectory.push_back(to_stamped(f.t_s, f.T_map_base));
+    trajectory.push_back(io::to_stamped(f.t_s, f.T_map_base));
     estimate.push_back(f.T_map_base);
   }
   io::write_tum_file(dir_ / "trajectory.tum", trajectory);

@@ -12,7 +12,7 @@
 #include "omnislam/io/dataset.hpp"
 #include "omnislam/io/ground_truth_files.hpp"
 #include "omnislam/io/image_file.hpp"
-#include "poses.hpp"
+#include "omnislam/io/poses.hpp"
 
 namespace omnislam::app {
 namespace {
@@ -87,7 +87,7 @@ ServiceInput make_service_input(io::Config &config, std::shared_ptr<dds::Odometr
     if (input.rate_hz < 0.0) result.rate_hz = info.rate_hz;
     std::vector<Eigen::Isometry2d> poses(static_cast<std::size_t>(info.frames),
                                          Eigen::Isometry2d::Identity());
-    if (input.odometry == "dataset") poses = to_isometries(io::read_tum_file(info.odometry));
+    if (input.odometry == "dataset") poses = io::to_isometries(io::read_tum_file(info.odometry));
     if (static_cast<int>(poses.size()) < info.frames)
       throw std::runtime_error(info.odometry.string() + ": too few poses");
     DatasetSourceOptions options;

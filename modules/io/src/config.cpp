@@ -56,6 +56,13 @@ void read_choice(YamlSection &section, const char *key, Enum &value,
   section.fail(key, message);
 }
 
+// An angle given in degrees in the file and kept in radians in the config.
+void read_degrees(YamlSection &section, const char *key, double &value_rad) {
+  double degrees = value_rad * 180.0 / std::numbers::pi;
+  section.read(key, degrees);
+  value_rad = degrees * std::numbers::pi / 180.0;
+}
+
 void read_vision(YamlSection &section, vision::VisionConfig &vision) {
   vision::CannyConfig &canny = vision.canny;
   section.read("sigma_px", canny.sigma_px);
@@ -129,15 +136,11 @@ void read_slam(YamlSection &section, slam::SlamConfig &slam) {
   section.read("max_rms_m", slam.max_rms_m);
   section.read("min_inlier_share", slam.min_inlier_share);
   section.read("max_correction_m", slam.max_correction_m);
-  double max_correction_deg = slam.max_correction_rad * 180.0 / std::numbers::pi;
-  section.read("max_correction_deg", max_correction_deg);
-  slam.max_correction_rad = max_correction_deg * std::numbers::pi / 180.0;
+  read_degrees(section, "max_correction_deg", slam.max_correction_rad);
   section.read("min_scan_points", slam.min_scan_points);
   section.read("use_odometry", slam.use_odometry);
   section.read("no_odometry_min_srel_percent", slam.no_odometry_min_srel_percent);
-  double no_odometry_max_rotation_deg = slam.no_odometry_max_rotation_rad * 180.0 / std::numbers::pi;
-  section.read("no_odometry_max_rotation_deg", no_odometry_max_rotation_deg);
-  slam.no_odometry_max_rotation_rad = no_odometry_max_rotation_deg * std::numbers::pi / 180.0;
+  read_degrees(section, "no_odometry_max_rotation_deg", slam.no_odometry_max_rotation_rad);
   section.read("fusion_radius_m", slam.map.fusion_radius_m);
   section.read("noise_radius_m", slam.map.noise_radius_m);
   section.read("noise_min_neighbors", slam.map.noise_min_neighbors);
@@ -180,38 +183,21 @@ Config load_config(const std::filesystem::path &file) {
   Config config;
   if (!root || root.IsNull()) return config;  // an empty file keeps every default
   YamlSection top(root, "", name);
-  if (top.has("camera")) {
-    YamlSection camera(top.node("camera"), "camera", name);
+  using detail::read_section;
+  read_section(top, "camera", name, [&](YamlSection &camera) {
     detail::read_camera_fields(camera, config.scan.camera);
     camera.read("camera_height_m", config.scan.camera_height_m);
     if (!(config.scan.camera_height_m > 0.0)) camera.fail("camera_height_m", "must be positive");
-    camera.finish();
-  }
-  if (top.has("vision")) {
-    YamlSection vision(top.node("vision"), "vision", name);
-    read_vision(vision, config.scan.vision);
-    vision.finish();
-  }
-  if (top.has("stereo")) {
-    YamlSection stereo(top.node("stereo"), "stereo", name);
-    read_stereo(stereo, config.scan.stereo);
-    stereo.finish();
-  }
-  if (top.has("slam")) {
-    YamlSection slam(top.node("slam"), "slam", name);
-    read_slam(slam, config.slam);
-    slam.finish();
-  }
-  if (top.has("persistence")) {
-    YamlSection persistence(top.node("persistence"), "persistence", name);
+  });
+  read_section(top, "vision", name, [&](YamlSection &vision) { read_vision(vision, config.scan.vision); });
+  read_section(top, "stereo", name, [&](YamlSection &stereo) { read_stereo(stereo, config.scan.stereo); });
+  read_section(top, "slam", name, [&](YamlSection &slam) { read_slam(slam, config.slam); });
+  read_section(top, "persistence", name, [&](YamlSection &persistence) {
     persistence.read("snapshot_period_s", config.persistence.snapshot_period_s);
     if (config.persistence.snapshot_period_s < 0.0) persistence.fail("snapshot_period_s", "must be >= 0");
-    bool refuse = config.persistence.refuse_corrupt_snapshot;
-    read_choice(persistence, "on_corrupt_snapshot", refuse, {{"start_fresh", false}, {"refuse", true}},
-                "must be start_fresh or refuse");
-    config.persistence.refuse_corrupt_snapshot = refuse;
-    persistence.finish();
-  }
+    read_choice(persistence, "on_corrupt_snapshot", config.persistence.refuse_corrupt_snapshot,
+                {{"start_fresh", false}, {"refuse", true}}, "must be start_fresh or refuse");
+  });
   detail::read_service_sections(top, name, config.service);
   top.finish();
   return config;

@@ -63,26 +63,12 @@ void read_dds(YamlSection &section, DdsSectionConfig &dds) {
 
 // The service's sections of load_config (config.cpp), kept apart from the algorithm ones.
 void read_service_sections(YamlSection &top, const std::string &file, ServiceConfig &service) {
-  if (top.has("input")) {
-    YamlSection section(top.node("input"), "input", file);
-    read_input(section, service.input);
-    section.finish();
-  }
-  if (top.has("pipeline")) {
-    YamlSection section(top.node("pipeline"), "pipeline", file);
-    read_pipeline(section, service.pipeline);
-    section.finish();
-  }
-  if (top.has("dds")) {
-    YamlSection section(top.node("dds"), "dds", file);
-    read_dds(section, service.dds);
-    section.finish();
-  }
-  if (top.has("service")) {
-    YamlSection section(top.node("service"), "service", file);
-    section.read("output_dir", service.output_dir);
-    section.finish();
-  }
+  read_section(top, "input", file, [&](YamlSection &section) { read_input(section, service.input); });
+  read_section(top, "pipeline", file,
+               [&](YamlSection &section) { read_pipeline(section, service.pipeline); });
+  read_section(top, "dds", file, [&](YamlSection &section) { read_dds(section, service.dds); });
+  read_section(top, "service", file,
+               [&](YamlSection &section) { section.read("output_dir", service.output_dir); });
 }
 
 }  // namespace omnislam::io::detail

@@ -84,6 +84,16 @@ class YamlSection {
   std::set<std::string> seen_;
 };
 
+/// Reads the sub-mapping `key` of `top`, if present, with `read(section)`, then rejects
+/// any key `read` did not ask for.
+template <typename Read>
+void read_section(YamlSection &top, const std::string &key, const std::string &file, Read &&read) {
+  if (!top.has(key)) return;
+  YamlSection section(top.node(key), key, file);
+  read(section);
+  section.finish();
+}
+
 /// Loads a YAML file, turning parse errors into ConfigError naming file:line.
 [[nodiscard]] inline YAML::Node load_yaml(const std::string &file) {
   try {

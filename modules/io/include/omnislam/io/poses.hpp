@@ -6,26 +6,27 @@
 
 #include "omnislam/io/ground_truth_files.hpp"
 
-// Conversions between TUM records and planar poses (yaw about z, z = 0 at floor level).
-namespace omnislam::app {
+/// @file
+/// Conversions between TUM records and planar poses (yaw about z, z = 0 at floor level).
+namespace omnislam::io {
 
-inline Eigen::Isometry2d to_isometry(const io::StampedPose &pose) {
+inline Eigen::Isometry2d to_isometry(const StampedPose &pose) {
   Eigen::Isometry2d T = Eigen::Isometry2d::Identity();
   T.linear() = Eigen::Rotation2Dd(pose.yaw_rad()).toRotationMatrix();
   T.translation() = Eigen::Vector2d(pose.x_m, pose.y_m);
   return T;
 }
 
-inline std::vector<Eigen::Isometry2d> to_isometries(const std::vector<io::StampedPose> &poses) {
+inline std::vector<Eigen::Isometry2d> to_isometries(const std::vector<StampedPose> &poses) {
   std::vector<Eigen::Isometry2d> out;
   out.reserve(poses.size());
-  for (const io::StampedPose &pose : poses) out.push_back(to_isometry(pose));
+  for (const StampedPose &pose : poses) out.push_back(to_isometry(pose));
   return out;
 }
 
-inline io::StampedPose to_stamped(double t_s, const Eigen::Isometry2d &T) {
+inline StampedPose to_stamped(double t_s, const Eigen::Isometry2d &T) {
   const double yaw = std::atan2(T.linear()(1, 0), T.linear()(0, 0));
-  io::StampedPose pose;
+  StampedPose pose;
   pose.t_s = t_s;
   pose.x_m = T.translation().x();
   pose.y_m = T.translation().y();
@@ -42,4 +43,4 @@ inline std::vector<Eigen::Isometry2d> relative_to_first(const std::vector<Eigen:
   return out;
 }
 
-}  // namespace omnislam::app
+}  // namespace omnislam::io
