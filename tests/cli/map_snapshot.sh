@@ -18,7 +18,7 @@ grep -q "saved $points map points and the pose of frame 10" "$work/save.txt" || 
 last=$(tail -n 1 "$work/run/trajectory.tum")
 x=$(echo "$last" | awk '{ printf "%.4f", $2 }')
 y=$(echo "$last" | awk '{ printf "%.4f", $3 }')
-grep -q "^version: 1$" "$work/info.txt" || fail "info: no version line"
+grep -q "^version: 2$" "$work/info.txt" || fail "info: no version line"
 grep -q "^map points: $points " "$work/info.txt" || fail "info: map points differ from map.csv ($points)"
 grep -q "^pose: x $x m, y $y m, .* t 0.900 s$" "$work/info.txt" || fail "info: pose is not the last of trajectory.tum ($x, $y)"
 grep -Eq "^frames: 10, integrated [0-9]+, not integrated [0-9]+, skipped 0, dropped 0$" "$work/info.txt" ||

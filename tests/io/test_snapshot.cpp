@@ -28,6 +28,7 @@ Snapshot example() {
   s.t_s = 12.5;
   s.T_map_base = Eigen::Translation2d(1.25, -0.5) * Eigen::Rotation2Dd(0.75);
   s.covariance << 1e-4, 2e-5, 0, 2e-5, 3e-4, 1e-6, 0, 1e-6, 5e-5;
+  s.T_odom_base = Eigen::Translation2d(3.5, 0.25) * Eigen::Rotation2Dd(-1.5);
   s.counters = {125, 120, 5, 2, 7};
   s.map_integrations = 120;
   for (int i = 0; i < 50; ++i) s.points.push_back({{0.1 * i, -0.05 * i}, 1 + i % 7, i});
@@ -44,14 +45,53 @@ void write_bytes(const fs::path &file, const std::vector<std::uint8_t> &bytes) {
       .write(reinterpret_cast<const char *>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
 }
 
+// Recomputes the header's payload size and CRC after a test edited the bytes.
+void reseal(std::vector<std::uint8_t> &bytes) {
+  const std::uint64_t payload = bytes.size() - 24;
+  for (int i = 0; i < 8; ++i)
+    bytes[12 + static_cast<std::size_t>(i)] = static_cast<std::uint8_t>(payload >> (8 * i));
+  uLong crc = crc32(0L, Z_NULL, 0);
+  crc = crc32(crc, bytes.data() + 8, 12);
+  crc = crc32(crc, bytes.data() + 24, static_cast<uInt>(payload));
+  for (int i = 0; i < 4; ++i)
+    bytes[20 + static_cast<std::size_t>(i)] = static_cast<std::uint8_t>(crc >> (8 * i));
+}
+
 }  // namespace
+
+TEST_CASE("snapshot: the odometry pose round-trips; version-1 files (without it) are still read",
+          "[io][snapshot]") {
+  const Snapshot written = example();
+  Snapshot read = omnislam::io::decode_snapshot(omnislam::io::encode_snapshot(written), "odom.snap");
+  REQUIRE(read.T_odom_base);
+  CHECK(read.T_odom_base->translation().isApprox(Eigen::Vector2d(3.5, 0.25), 1e-12));
+  CHECK(Eigen::Rotation2Dd(read.T_odom_base->linear()).angle() == Approx(-1.5).margin(1e-12));
+
+  Snapshot without = example();
+  without.T_odom_base.reset();
+  CHECK_FALSE(omnislam::io::decode_snapshot(omnislam::io::encode_snapshot(without), "none.snap").T_odom_base);
+
+  // Version 1: the same bytes without the 32-byte odometry block after map_integrations.
+  std::vector<std::uint8_t> v1 = omnislam::io::encode_snapshot(written);
+  const std::size_t odometry_at = 24 + 8 + 4 * 8 + 9 * 8 + 5 * 8 + 8;
+  v1.erase(v1.begin() + static_cast<std::ptrdiff_t>(odometry_at),
+           v1.begin() + static_cast<std::ptrdiff_t>(odometry_at + 32));
+  v1[8] = 1;
+  reseal(v1);
+  read = omnislam::io::decode_snapshot(v1, "v1.snap");
+  CHECK_FALSE(read.T_odom_base);
+  CHECK(read.points.size() == 50);
+  CHECK(read.version == 1);
+  CHECK(read.points[49].first_seen == 49);
+  CHECK(read.counters.dropped == 7);
+}
 
 TEST_CASE("snapshot: written atomically and read back exactly", "[io][snapshot]") {
   const fs::path dir = scratch("roundtrip");
   const Snapshot written = example();
   omnislam::io::write_snapshot(dir / "state.snap", written);
-  // 24-byte header + 168-byte fixed payload + 24 bytes per point; no temporary left over.
-  CHECK(fs::file_size(dir / "state.snap") == 24 + 168 + 24 * 50);
+  // 24-byte header + 200-byte fixed payload + 24 bytes per point; no temporary left over.
+  CHECK(fs::file_size(dir / "state.snap") == 24 + 200 + 24 * 50);
   CHECK(std::distance(fs::directory_iterator(dir), fs::directory_iterator()) == 1);
 
   const Snapshot read = omnislam::io::read_snapshot(dir / "state.snap");
@@ -103,7 +143,7 @@ TEST_CASE("snapshot: truncation, bit flips, other versions and bad values are re
   }
   const std::vector<std::uint8_t> header_only(good.begin(), good.begin() + 30);
   CHECK_THROWS_WITH(omnislam::io::decode_snapshot(header_only, "cut.snap"),
-                    Catch::Contains("cut.snap: truncated") && Catch::Contains("1368 payload bytes") &&
+                    Catch::Contains("cut.snap: truncated") && Catch::Contains("1400 payload bytes") &&
                         Catch::Contains("has 6"));
   // A flipped bit anywhere after the magic fails the checksum (or, in the size field, the length).
   for (std::size_t i = 8; i < good.size(); i += 37) {
@@ -125,16 +165,13 @@ TEST_CASE("snapshot: truncation, bit flips, other versions and bad values are re
 
 TEST_CASE("snapshot: a future version or impossible values are named even with a valid checksum",
           "[io][snapshot]") {
-  // A version-2 file (as a newer build would write it) has a valid CRC of its own.
-  std::vector<std::uint8_t> v2 = omnislam::io::encode_snapshot(example());
-  v2[8] = 2;
-  uLong crc = crc32(0L, Z_NULL, 0);
-  crc = crc32(crc, v2.data() + 8, 12);
-  crc = crc32(crc, v2.data() + 24, static_cast<uInt>(v2.size() - 24));
-  for (int i = 0; i < 4; ++i)
-    v2[20 + static_cast<std::size_t>(i)] = static_cast<std::uint8_t>(crc >> (8 * i));
-  CHECK_THROWS_WITH(omnislam::io::decode_snapshot(v2, "v2.snap"),
-                    Catch::Equals("v2.snap: unsupported snapshot version 2 (this build reads version 1)"));
+  // A version-3 file (as a newer build would write it) has a valid CRC of its own.
+  std::vector<std::uint8_t> v3 = omnislam::io::encode_snapshot(example());
+  v3[8] = 3;
+  reseal(v3);
+  CHECK_THROWS_WITH(
+      omnislam::io::decode_snapshot(v3, "v3.snap"),
+      Catch::Equals("v3.snap: unsupported snapshot version 3 (this build reads versions 1 to 2)"));
 
   Snapshot bad = example();
   bad.points[3].hits = 0;

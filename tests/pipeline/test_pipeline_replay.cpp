@@ -83,6 +83,7 @@ pipeline::FrameSource memory_source(const Input &in, int frames) {
     frame->stamp_s = static_cast<double>(i);  // the dataset index, for the ground truth
     frame->image = in.images[i];
     frame->T_odom_base = in.odometry[i];
+    frame->has_odometry = true;
     return frame;
   };
 }

@@ -22,13 +22,21 @@ void print_info(const std::filesystem::path &file) {
       std::atan2(s.T_map_base.linear()(1, 0), s.T_map_base.linear()(0, 0)) * 180.0 / std::numbers::pi;
   const io::SnapshotCounters &n = s.counters;
   std::printf("snapshot: %s\n", file.c_str());
-  std::printf("version: %u\n", io::kSnapshotVersion);
+  std::printf("version: %u\n", s.version);
   std::printf("config_hash: %016" PRIx64 "\n", s.config_hash);
   std::printf("map points: %zu (after %d integrations)\n", s.points.size(), s.map_integrations);
   std::printf("pose: x %.4f m, y %.4f m, yaw %.3f deg, t %.3f s\n", s.T_map_base.translation().x(),
               s.T_map_base.translation().y(), yaw_deg, s.t_s);
   std::printf("pose sigma: x %.4f m, y %.4f m, yaw %.3f deg\n", std::sqrt(s.covariance(0, 0)),
               std::sqrt(s.covariance(1, 1)), std::sqrt(s.covariance(2, 2)) * 180.0 / std::numbers::pi);
+  if (s.T_odom_base) {
+    std::printf(
+        "odometry: x %.4f m, y %.4f m, yaw %.3f deg\n", s.T_odom_base->translation().x(),
+        s.T_odom_base->translation().y(),
+        std::atan2(s.T_odom_base->linear()(1, 0), s.T_odom_base->linear()(0, 0)) * 180.0 / std::numbers::pi);
+  } else {
+    std::printf("odometry: none\n");
+  }
   std::printf("frames: %" PRIu64 ", integrated %" PRIu64 ", not integrated %" PRIu64 ", skipped %" PRIu64
               ", dropped %" PRIu64 "\n",
               n.frames, n.integrated, n.not_integrated, n.skipped, n.dropped);

@@ -19,8 +19,9 @@ namespace omnislam::io {
 namespace {
 
 constexpr std::string_view kMagic = "OMNISNAP";
-constexpr std::size_t kHeaderBytes = 24;  // magic, version, payload size, CRC
-constexpr std::size_t kFixedPayloadBytes = 8 + 8 * 4 + 8 * 9 + 8 * 5 + 8 + 8;
+constexpr std::size_t kHeaderBytes = 24;           // magic, version, payload size, CRC
+constexpr std::size_t kOdometryBytes = 8 + 3 * 8;  // version 2 only
+constexpr std::size_t kFixedPayloadBytesV1 = 8 + 8 * 4 + 8 * 9 + 8 * 5 + 8 + 8;
 constexpr std::size_t kPointBytes = 8 + 8 + 4 + 4;
 
 class ByteWriter {
@@ -115,6 +116,11 @@ std::vector<std::uint8_t> encode_snapshot(const Snapshot &snapshot) {
   for (std::uint64_t count : {n.frames, n.integrated, n.not_integrated, n.skipped, n.dropped})
     payload.u64(count);
   payload.i64(snapshot.map_integrations);
+  const Eigen::Isometry2d odom = snapshot.T_odom_base.value_or(Eigen::Isometry2d::Identity());
+  payload.u64(snapshot.T_odom_base ? 1 : 0);
+  payload.f64(odom.translation().x());
+  payload.f64(odom.translation().y());
+  payload.f64(std::atan2(odom.linear()(1, 0), odom.linear()(0, 0)));
   payload.u64(snapshot.points.size());
   for (const slam::MapPoint &p : snapshot.points) {
     payload.f64(p.position_m.x());
@@ -154,14 +160,16 @@ Snapshot decode_snapshot(std::span<const std::uint8_t> bytes, const std::string 
   if (checksum(bytes.subspan(kMagic.size(), 12), payload) != stored_crc) {
     throw SnapshotError(name + ": checksum mismatch (the file is corrupt)");
   }
-  if (version != kSnapshotVersion) {
+  if (version < 1 || version > kSnapshotVersion) {
     throw SnapshotError(name + ": unsupported snapshot version " + std::to_string(version) +
-                        " (this build reads version " + std::to_string(kSnapshotVersion) + ")");
+                        " (this build reads versions 1 to " + std::to_string(kSnapshotVersion) + ")");
   }
-  if (payload.size() < kFixedPayloadBytes) throw SnapshotError(name + ": truncated payload");
+  const std::size_t fixed_bytes = kFixedPayloadBytesV1 + (version >= 2 ? kOdometryBytes : 0);
+  if (payload.size() < fixed_bytes) throw SnapshotError(name + ": truncated payload");
 
   ByteReader in(payload, name);
   Snapshot s;
+  s.version = version;
   s.config_hash = in.u64();
   s.t_s = in.f64("t_s");
   const double x = in.f64("x_m"), y = in.f64("y_m"), yaw = in.f64("yaw_rad");
@@ -176,8 +184,14 @@ Snapshot decode_snapshot(std::span<const std::uint8_t> bytes, const std::string 
     throw SnapshotError(name + ": map_integrations " + std::to_string(integrations) + " out of range");
   }
   s.map_integrations = static_cast<int>(integrations);
+  if (version >= 2) {
+    const std::uint64_t has_odometry = in.u64();
+    if (has_odometry > 1) throw SnapshotError(name + ": has_odometry is " + std::to_string(has_odometry));
+    const double ox = in.f64("odom x_m"), oy = in.f64("odom y_m"), oyaw = in.f64("odom yaw_rad");
+    if (has_odometry == 1) s.T_odom_base = Eigen::Translation2d(ox, oy) * Eigen::Rotation2Dd(oyaw);
+  }
   const std::uint64_t count = in.u64();
-  const std::uint64_t point_bytes = payload.size() - kFixedPayloadBytes;
+  const std::uint64_t point_bytes = payload.size() - fixed_bytes;
   if (point_bytes % kPointBytes != 0 || point_bytes / kPointBytes != count) {
     throw SnapshotError(name + ": announces " + std::to_string(count) + " map points but holds " +
                         std::to_string(point_bytes) + " bytes of points");

@@ -214,7 +214,8 @@ void Pipeline::slam_loop() {
   while (take(queues_[kSlamQueue], kSlamQueue, frame)) {
     busy(3, true);
     StepClock clock(*frame);
-    frame->estimate = slam_.process(scan_points(frame->scan), frame->T_odom_base);
+    frame->estimate = slam_.process(scan_points(frame->scan),
+                                    frame->has_odometry ? std::optional(frame->T_odom_base) : std::nullopt);
     clock.lap(kSlam);
     if (frame->estimate.integrated) {
       const Clock::time_point now = Clock::now();

@@ -91,14 +91,21 @@ FrameEstimate Slam::register_scan(const Points2 &scan_base, const Eigen::Isometr
 }
 
 void Slam::resume(std::vector<MapPoint> points, int integrations, const Eigen::Isometry2d &T_map_base,
-                  const Eigen::Matrix3d &covariance) {
+                  const Eigen::Matrix3d &covariance, const std::optional<Eigen::Isometry2d> &T_odom_base) {
   map_ = PointMap(config_.map, std::move(points), integrations);
-  previous_T_odom_base_.reset();
+  started_ = true;
+  anchor_T_odom_base_ = T_odom_base;
+  anchor_T_map_base_ = T_map_base;
   previous_ = {T_map_base, true, Attempt::kNone, {}, covariance};
   // Until a scan has been seen, the whole map stands in for the previous local map.
   recent_scans_map_.assign(1, map_.index().points());
   relaxation_percent_ = 0.0;
   previous_failed_ = false;
+}
+
+void Slam::set_anchor(const Eigen::Isometry2d &T_odom_base, const Eigen::Isometry2d &T_map_base) {
+  anchor_T_odom_base_ = T_odom_base;
+  anchor_T_map_base_ = T_map_base;
 }
 
 FrameEstimate Slam::seed_map(const Points2 &scan_base) {
@@ -110,16 +117,27 @@ FrameEstimate Slam::seed_map(const Points2 &scan_base) {
   return previous_;
 }
 
-FrameEstimate Slam::process(const Points2 &scan_base, const Eigen::Isometry2d &T_odom_base) {
-  Eigen::Isometry2d step = Eigen::Isometry2d::Identity();
-  if (!previous_T_odom_base_) {
-    previous_T_odom_base_ = T_odom_base;
-    if (map_.empty() && !config_.localization_only) return seed_map(scan_base);
-  } else if (config_.use_odometry) {
-    step = previous_T_odom_base_->inverse() * T_odom_base;
+FrameEstimate Slam::process(const Points2 &scan_base, const std::optional<Eigen::Isometry2d> &T_odom_base) {
+  const bool first = !started_;
+  started_ = true;
+  if (first && map_.empty() && !config_.localization_only) {
+    FrameEstimate estimate = seed_map(scan_base);
+    if (T_odom_base) set_anchor(*T_odom_base, estimate.T_map_base);
+    return estimate;
   }
-  previous_T_odom_base_ = T_odom_base;
-  const Eigen::Isometry2d predicted = previous_.T_map_base * step;
+  // The odometry motion since the anchor (the previous frame unless odometry had a gap).
+  // Without odometry the robot is predicted to keep the last frame-to-frame motion.
+  Eigen::Isometry2d step = Eigen::Isometry2d::Identity();
+  Eigen::Isometry2d from = previous_.T_map_base;
+  if (config_.use_odometry) {
+    if (!T_odom_base) {
+      step = last_step_;
+    } else if (anchor_T_odom_base_) {
+      step = anchor_T_odom_base_->inverse() * *T_odom_base;
+      from = anchor_T_map_base_;
+    }
+  }
+  const Eigen::Isometry2d predicted = from * step;
 
   FrameEstimate estimate;
   estimate.T_map_base = predicted;
@@ -136,7 +154,11 @@ FrameEstimate Slam::process(const Points2 &scan_base, const Eigen::Isometry2d &T
 
   if (estimate.integrated) {
     relaxation_percent_ = 0.0;
-    if (!config_.localization_only) map_.integrate(transformed(scan_base, estimate.T_map_base));
+    // A frame without odometry is registered but never changes the map: along a corridor
+    // the scan fits anywhere, and only odometry tells where.
+    const bool odometry_gap = config_.use_odometry && !T_odom_base;
+    if (!config_.localization_only && !odometry_gap)
+      map_.integrate(transformed(scan_base, estimate.T_map_base));
   } else {
     relaxation_percent_ += config_.srel_relax_percent;
     const Eigen::Matrix2d R = previous_.T_map_base.linear();
@@ -145,6 +167,8 @@ FrameEstimate Slam::process(const Points2 &scan_base, const Eigen::Isometry2d &T
     estimate.covariance = previous_.covariance + rotate * odometry_step_covariance(step) * rotate.transpose();
   }
   previous_failed_ = !estimate.integrated;
+  if (T_odom_base) set_anchor(*T_odom_base, estimate.T_map_base);
+  last_step_ = previous_.T_map_base.inverse() * estimate.T_map_base;  // extrapolated through gaps
   // Thesis fig. 5.3: second_last = last every iteration, integrated or not.
   recent_scans_map_.push_front(transformed(scan_base, estimate.T_map_base));
   if (recent_scans_map_.size() > 3) recent_scans_map_.pop_back();

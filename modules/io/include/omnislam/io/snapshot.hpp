@@ -15,7 +15,7 @@
 /// Snapshots of the SLAM state (map, pose, counters, configuration hash) that a service
 /// writes periodically into its state directory and resumes from after a restart.
 ///
-/// File format, version 1 (all integers and doubles little-endian):
+/// File format, version 2 (all integers and doubles little-endian):
 /// ```
 /// offset  size  field
 ///  0       8    magic "OMNISNAP"
@@ -25,12 +25,14 @@
 /// 24       -    payload: u64 config_hash, f64 t_s, f64 x_m, f64 y_m, f64 yaw_rad,
 ///               9 x f64 covariance (row-major, x y yaw), u64 frames, u64 integrated,
 ///               u64 not_integrated, u64 skipped, u64 dropped, i64 map_integrations,
+///               u64 has_odometry (0 or 1), f64 odom x_m, f64 odom y_m, f64 odom yaw_rad,
 ///               u64 point count, then per point f64 x_m, f64 y_m, i32 hits, i32 first_seen
 /// ```
+/// Version 1 is version 2 without the four odometry fields; it is still read.
 
 namespace omnislam::io {
 
-inline constexpr std::uint32_t kSnapshotVersion = 1;
+inline constexpr std::uint32_t kSnapshotVersion = 2;
 
 /// A snapshot that cannot be used: missing, truncated, of another version, failing its
 /// checksum, or holding impossible values. The message names the file.
@@ -48,10 +50,15 @@ struct SnapshotCounters {
 };
 
 struct Snapshot {
-  std::uint64_t config_hash = 0;  ///< config_file_hash() of the configuration that built the map
-  double t_s = 0.0;               ///< capture time of the last frame in the snapshot
+  std::uint32_t version = kSnapshotVersion;  ///< of the file it was read from (written: always the newest)
+  std::uint64_t config_hash = 0;             ///< config_file_hash() of the configuration that built the map
+  double t_s = 0.0;                          ///< capture time of the last frame in the snapshot
   Eigen::Isometry2d T_map_base = Eigen::Isometry2d::Identity();  ///< last pose (planar)
   Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();          ///< of (x, y, yaw), map frame
+  /// The odometry pose of the last frame, when it had one: a resumed run whose odometry
+  /// keeps its frame (a dataset, a base driver that kept running) predicts its first frame
+  /// from it instead of assuming the robot stood still.
+  std::optional<Eigen::Isometry2d> T_odom_base;
   SnapshotCounters counters;
   int map_integrations = 0;  ///< slam::PointMap::integrations() (the age reference of first_seen)
   std::vector<slam::MapPoint> points;

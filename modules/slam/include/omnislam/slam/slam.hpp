@@ -77,15 +77,24 @@ class Slam {
 
   /// Processes one local scan (base_link points, metres) with the odometry pose of the
   /// same frame (any fixed odom frame). The first frame defines the map frame, unless the
-  /// state was resumed: then the first frame is predicted at the resumed pose.
-  [[nodiscard]] FrameEstimate process(const Points2 &scan_base, const Eigen::Isometry2d &T_odom_base);
+  /// state was resumed: then the first frame is predicted from the resumed pose.
+  ///
+  /// A frame without odometry (empty: a gap in the odometry stream) is predicted to keep
+  /// the last frame-to-frame motion and registered as usual, but never integrated into the
+  /// map (along a corridor a scan fits anywhere). The odometry chain is kept across the
+  /// gap: the next frame with odometry is predicted from the last frame that had odometry,
+  /// so no motion is counted twice or lost.
+  [[nodiscard]] FrameEstimate process(const Points2 &scan_base,
+                                      const std::optional<Eigen::Isometry2d> &T_odom_base);
 
   /// Continues from a saved state (map points with their integration count, and the last
-  /// pose with its (x, y, yaw) covariance) instead of starting a new map. The next frame's
-  /// odometry is taken to be at `T_map_base` (the robot did not move in between); it is
+  /// pose with its (x, y, yaw) covariance) instead of starting a new map. With the saved
+  /// frame's odometry pose, the next frame is predicted from the odometry motion since
+  /// (the odometry frame must be the same: a dataset, a base driver that kept running);
+  /// without it, the robot is taken not to have moved. Either way the next frame is
   /// registered against the restored map.
   void resume(std::vector<MapPoint> points, int integrations, const Eigen::Isometry2d &T_map_base,
-              const Eigen::Matrix3d &covariance);
+              const Eigen::Matrix3d &covariance, const std::optional<Eigen::Isometry2d> &T_odom_base = {});
 
   [[nodiscard]] const PointMap &map() const { return map_; }
 
@@ -93,6 +102,7 @@ class Slam {
   [[nodiscard]] bool accept(const TrimmedIcpResult &registration, const Eigen::Isometry2d &predicted,
                             const Eigen::Isometry2d &estimate, double srel_limit_percent) const;
   [[nodiscard]] FrameEstimate register_scan(const Points2 &scan_base, const Eigen::Isometry2d &predicted);
+  void set_anchor(const Eigen::Isometry2d &T_odom_base, const Eigen::Isometry2d &T_map_base);
   [[nodiscard]] FrameEstimate seed_map(const Points2 &scan_base);
   [[nodiscard]] bool accept_without_odometry(const TrimmedIcpResult &registration,
                                              const Eigen::Isometry2d &predicted,
@@ -100,8 +110,13 @@ class Slam {
 
   SlamConfig config_;
   PointMap map_;
-  std::optional<Eigen::Isometry2d> previous_T_odom_base_;
+  bool started_ = false;
+  /// The last frame that had odometry: its odometry pose and its estimate. Predictions
+  /// compose the odometry motion since onto it.
+  std::optional<Eigen::Isometry2d> anchor_T_odom_base_;
+  Eigen::Isometry2d anchor_T_map_base_ = Eigen::Isometry2d::Identity();
   FrameEstimate previous_;
+  Eigen::Isometry2d last_step_ = Eigen::Isometry2d::Identity();  ///< previous_ relative to the frame before
   std::deque<Points2> recent_scans_map_;  ///< newest first: the last scans at their estimated poses
   double relaxation_percent_ = 0.0;
   bool previous_failed_ = false;
