@@ -117,16 +117,29 @@ TEST_CASE("config: persistence and localization keys", "[io][config]") {
   const auto file = write_file("persistence.yaml",
                                "slam: {localization_only: true}\n"
                                "persistence:\n"
+                               "  state_dir: /var/lib/omnislam-test\n"
+                               "  resume: false\n"
                                "  snapshot_period_s: 5\n"
-                               "  on_corrupt_snapshot: refuse\n");
+                               "  on_corrupt_snapshot: refuse\n"
+                               "service: {stage_timeout_s: 2.5}\n");
   const omnislam::io::Config config = omnislam::io::load_config(file);
   CHECK(config.slam.localization_only);
+  CHECK(config.persistence.state_dir == "/var/lib/omnislam-test");
+  CHECK_FALSE(config.persistence.resume);
+  CHECK(config.service.stage_timeout_s == 2.5);
   CHECK(config.persistence.snapshot_period_s == 5.0);
   CHECK(config.persistence.refuse_corrupt_snapshot);
   const omnislam::io::Config defaults;
   CHECK_FALSE(defaults.slam.localization_only);
   CHECK(defaults.persistence.snapshot_period_s == 30.0);
   CHECK_FALSE(defaults.persistence.refuse_corrupt_snapshot);
+  CHECK(defaults.persistence.resume);
+  CHECK(defaults.persistence.state_dir.empty());
+  CHECK(defaults.service.stage_timeout_s == 5.0);
+  CHECK_THROWS_WITH(omnislam::io::load_config(write_file("stage.yaml", "service:\n  stage_timeout_s: 0\n")),
+                    Catch::EndsWith("stage.yaml:2:20: 'service.stage_timeout_s' must be positive"));
+  CHECK_THROWS_WITH(omnislam::io::load_config(write_file("resume.yaml", "persistence: {resume: maybe}\n")),
+                    Catch::Contains("resume.yaml:1:23: 'persistence.resume'"));
 }
 
 TEST_CASE("dataset.yaml: an images pattern other than one %d field is refused", "[io][bad-input]") {

@@ -13,6 +13,7 @@ pipeline::FrameSource dataset_source(const io::DatasetInfo &info, std::vector<Ei
   auto next = std::make_shared<int>(0);
   return [info, odometry = std::move(odometry), camera, options = std::move(options), next]() {
     const int frames = info.frames;
+    while (*next < frames * options.loops && *next / info.rate_hz <= options.after_s) ++*next;
     if (frames <= 0 || *next >= frames * options.loops) return pipeline::FramePtr();
     const int index = (*next)++;
     const int frame_number = index % frames + 1;

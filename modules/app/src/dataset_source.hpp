@@ -2,6 +2,7 @@
 
 #include <Eigen/Geometry>
 #include <functional>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -13,6 +14,9 @@ namespace omnislam::app {
 
 struct DatasetSourceOptions {
   int loops = 1;  ///< play the dataset this many times (stamps keep increasing)
+  /// Frames stamped at or before this are passed over unread (a service resuming the
+  /// dataset from a snapshot taken at this time).
+  double after_s = -std::numeric_limits<double>::infinity();
   /// Called (on the capture thread) for an image that cannot be used; the frame goes on
   /// as skipped, so SLAM still gets its odometry.
   std::function<void(int frame, const std::string &error)> on_skip;

@@ -1,11 +1,14 @@
 #include "evaluate_command.hpp"
 
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include "omnislam/io/dataset.hpp"
 #include "omnislam/io/poses.hpp"
@@ -23,24 +26,38 @@ std::vector<slam::Segment2> floorplan_segments(const std::filesystem::path &file
   return segments;
 }
 
-nlohmann::json to_json(const slam::TrajectoryError &e) {
-  return {{"rmse_m", e.rmse_m}, {"max_m", e.max_m}, {"final_m", e.final_m}, {"max_frame", e.max_frame + 1}};
+// max_frame: the 1-based dataset frame of the largest error.
+nlohmann::json to_json(const slam::TrajectoryError &e, int max_frame) {
+  return {{"rmse_m", e.rmse_m}, {"max_m", e.max_m}, {"final_m", e.final_m}, {"max_frame", max_frame}};
 }
 
 void evaluate(const std::filesystem::path &run_dir, const std::filesystem::path &dataset_dir) {
   const io::DatasetInfo info = io::read_dataset_info(dataset_dir);
   if (info.groundtruth.empty())
     throw std::runtime_error(dataset_dir.string() + ": no groundtruth in dataset.yaml");
-  auto truth = io::relative_to_first(io::to_isometries(io::read_tum_file(info.groundtruth)));
-  auto odometry = io::relative_to_first(io::to_isometries(io::read_tum_file(info.odometry)));
-  const auto estimate = io::to_isometries(io::read_tum_file(run_dir / "trajectory.tum"));
-  if (estimate.size() > truth.size()) {
-    throw std::runtime_error((run_dir / "trajectory.tum").string() + " has " +
-                             std::to_string(estimate.size()) + " poses but the ground truth only " +
-                             std::to_string(truth.size()));
+  const auto all_truth = io::relative_to_first(io::to_isometries(io::read_tum_file(info.groundtruth)));
+  const auto all_odometry = io::relative_to_first(io::to_isometries(io::read_tum_file(info.odometry)));
+  const auto stamped = io::read_tum_file(run_dir / "trajectory.tum");
+  // Each pose is compared with the ground truth of its dataset frame, found from its time
+  // stamp ((frame - 1) / rate): a resumed run starts later, a looped one plays frames again.
+  std::vector<Eigen::Isometry2d> estimate, truth, odometry;
+  std::vector<int> frame_of;  // 0-based dataset frame of each pose
+  const std::size_t frames = std::min(all_truth.size(), all_odometry.size());
+  for (std::size_t i = 0; i < stamped.size(); ++i) {
+    const double index = stamped[i].t_s * info.rate_hz;
+    const double rounded = std::round(index);
+    if (std::abs(index - rounded) > 1e-3 || rounded < 0.0 || frames == 0) {
+      throw std::runtime_error((run_dir / "trajectory.tum").string() + ": pose " + std::to_string(i + 1) +
+                               " at t " + std::to_string(stamped[i].t_s) + " s is not at a frame time of " +
+                               dataset_dir.string() + " (" + std::to_string(info.rate_hz) + " Hz)");
+    }
+    const auto frame = static_cast<std::size_t>(rounded) % frames;
+    estimate.push_back(io::to_isometry(stamped[i]));
+    truth.push_back(all_truth[frame]);
+    odometry.push_back(all_odometry[frame]);
+    frame_of.push_back(static_cast<int>(frame));
   }
-  truth.resize(estimate.size());
-  odometry.resize(estimate.size());
+  if (estimate.empty()) throw std::runtime_error((run_dir / "trajectory.tum").string() + ": no poses");
   const auto slam_error = slam::trajectory_error(estimate, truth);
   const auto odometry_error = slam::trajectory_error(odometry, truth);
 
@@ -50,17 +67,17 @@ void evaluate(const std::filesystem::path &run_dir, const std::filesystem::path 
   const auto map = slam::map_error(map_points, floorplan_segments(info.floorplan));
 
   std::printf("trajectory (%zu frames): rmse %.1f mm, max %.1f mm (frame %d), final %.1f mm\n",
-              estimate.size(), slam_error.rmse_m * 1e3, slam_error.max_m * 1e3, slam_error.max_frame + 1,
-              slam_error.final_m * 1e3);
+              estimate.size(), slam_error.rmse_m * 1e3, slam_error.max_m * 1e3,
+              frame_of[slam_error.max_frame] + 1, slam_error.final_m * 1e3);
   std::printf("odometry alone:          rmse %.1f mm, max %.1f mm (frame %d), final %.1f mm\n",
-              odometry_error.rmse_m * 1e3, odometry_error.max_m * 1e3, odometry_error.max_frame + 1,
+              odometry_error.rmse_m * 1e3, odometry_error.max_m * 1e3, frame_of[odometry_error.max_frame] + 1,
               odometry_error.final_m * 1e3);
   std::printf("map (%zu points): median distance to floor plan %.1f mm, p90 %.1f mm, completeness %.1f%%\n",
               map.points, map.median_distance_m * 1e3, map.p90_distance_m * 1e3, map.completeness * 100.0);
 
   nlohmann::json out;
-  out["ate"] = to_json(slam_error);
-  out["odometry_ate"] = to_json(odometry_error);
+  out["ate"] = to_json(slam_error, frame_of[slam_error.max_frame] + 1);
+  out["odometry_ate"] = to_json(odometry_error, frame_of[odometry_error.max_frame] + 1);
   out["map"] = {{"points", map.points},
                 {"median_distance_m", map.median_distance_m},
                 {"p90_distance_m", map.p90_distance_m},
@@ -69,7 +86,8 @@ void evaluate(const std::filesystem::path &run_dir, const std::filesystem::path 
   std::ostringstream csv;
   csv << "frame,error_m,odometry_error_m\n";
   for (std::size_t i = 0; i < estimate.size(); ++i) {
-    csv << i + 1 << ',' << slam_error.per_frame_m[i] << ',' << odometry_error.per_frame_m[i] << '\n';
+    csv << frame_of[i] + 1 << ',' << slam_error.per_frame_m[i] << ',' << odometry_error.per_frame_m[i]
+        << '\n';
   }
   io::write_text_file(run_dir / "errors.csv", csv.str());
 }

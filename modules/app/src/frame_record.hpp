@@ -11,6 +11,7 @@ namespace omnislam::app {
   record.t_s = frame.stamp_s;
   record.T_map_base = frame.estimate.T_map_base;
   record.T_odom_base = frame.T_odom_base;
+  record.has_odometry = frame.has_odometry;
   record.covariance = frame.estimate.covariance;
   record.skipped = frame.skipped();
   record.integrated = frame.estimate.integrated;

@@ -1,13 +1,18 @@
 // omnislamd: the real-time service (architecture.md "Service"): the staged pipeline from
-// the configured input to DDS topics and, at shutdown, the run files.
+// the configured input to DDS topics; systemd notification and watchdog; periodic
+// snapshots of the map and pose, resumed after a restart; at shutdown, the run files.
 
 #include <spdlog/spdlog.h>
 
 #include <CLI/CLI.hpp>
+#include <atomic>
 #include <chrono>
 #include <csignal>
 #include <cstdio>
+#include <cstdlib>
 #include <exception>
+#include <filesystem>
+#include <limits>
 #include <memory>
 #include <optional>
 
@@ -15,24 +20,166 @@
 #include "omnislam/dds/odometry_reader.hpp"
 #include "omnislam/dds/publisher.hpp"
 #include "omnislam/io/config.hpp"
+#include "omnislam/io/snapshot.hpp"
 #include "omnislam/pipeline/pipeline.hpp"
 #include "run_outputs.hpp"
 #include "service_input.hpp"
+#include "snapshot_writer.hpp"
+#include "systemd_notify.hpp"
 
 namespace {
 
 using namespace omnislam;
 using namespace omnislam::app;
 
+/// Exit codes: 2 configuration error, 3 the saved state cannot be used (a corrupt snapshot
+/// under on_corrupt_snapshot: refuse, or localization without a map). The unit does not
+/// restart on either: the same start would fail the same way.
+constexpr int kExitConfig = 2;
+constexpr int kExitState = 3;
+
+class StateError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
 double system_time_s() {
   return std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
 }
 
+pipeline::PipelineConfig pipeline_config(const io::Config &config, double rate_hz, bool snapshots) {
+  const io::PipelineSectionConfig &section = config.service.pipeline;
+  pipeline::PipelineConfig result;
+  result.mode = section.mode == "replay" ? pipeline::Mode::kReplay : pipeline::Mode::kLive;
+  result.queue_capacity = static_cast<std::size_t>(section.queue_capacity);
+  result.input_rate_hz = rate_hz;
+  result.map_period_s = section.map_rate_hz > 0.0 ? 1.0 / section.map_rate_hz : 0.0;
+  result.profile_period_s = section.profile_period_s;
+  result.profile_window = static_cast<std::size_t>(section.profile_window);
+  if (snapshots) result.state_period_s = config.persistence.snapshot_period_s;
+  // Fault injection for the watchdog test (tests/python/test_omnislamd_notify.py):
+  // OMNISLAM_TEST_STALL=STAGE:FRAME holds that frame in that stage until shutdown.
+  if (const char *stall = std::getenv("OMNISLAM_TEST_STALL")) {
+    const std::string text(stall);
+    const auto colon = text.find(':');
+    for (std::size_t i = 1; i < pipeline::Pipeline::kThreads.size() && colon != std::string::npos; ++i) {
+      if (text.substr(0, colon) == pipeline::Pipeline::kThreads[i]) {
+        result.stall_thread = i;
+        result.stall_at_frame = std::stoull(text.substr(colon + 1));
+        spdlog::warn("OMNISLAM_TEST_STALL: the {} stage will hang on frame {}", text.substr(0, colon),
+                     result.stall_at_frame);
+      }
+    }
+  }
+  return result;
+}
+
+// persistence.state_dir, else systemd's $STATE_DIRECTORY; empty: no persistence.
+std::filesystem::path state_file(const io::PersistenceConfig &persistence) {
+  std::string dir = persistence.state_dir;
+  if (dir.empty()) {
+    const char *from_systemd = std::getenv("STATE_DIRECTORY");
+    if (from_systemd != nullptr)
+      dir = std::string(from_systemd).substr(0, std::string(from_systemd).find(':'));
+  }
+  return dir.empty() ? std::filesystem::path() : std::filesystem::path(dir) / "state.omnisnap";
+}
+
+std::optional<io::Snapshot> resume_state(const io::Config &config, const std::filesystem::path &file,
+                                         std::uint64_t config_hash) {
+  std::optional<io::Snapshot> snapshot;
+  if (!file.empty() && config.persistence.resume) {
+    const auto policy = config.persistence.refuse_corrupt_snapshot ? io::CorruptSnapshotPolicy::kRefuse
+                                                                   : io::CorruptSnapshotPolicy::kStartFresh;
+    io::ResumeResult resumed;
+    try {
+      resumed = io::resume_from_snapshot(file, policy);
+    } catch (const io::SnapshotError &error) {
+      throw StateError(error.what());
+    }
+    if (resumed.moved_aside_to.empty()) {
+      spdlog::info("{}", resumed.message);
+    } else {
+      spdlog::error("{}", resumed.message);
+    }
+    snapshot = std::move(resumed.snapshot);
+  }
+  if (snapshot && snapshot->config_hash != config_hash) {
+    spdlog::warn(
+        "the snapshot's map was built under another configuration (hash {:016x}, now {:016x}); "
+        "continuing with it",
+        snapshot->config_hash, config_hash);
+  }
+  if (config.slam.localization_only && !snapshot) {
+    throw StateError("slam.localization_only needs a saved map, and there is none" +
+                     (file.empty() ? std::string(" (no persistence.state_dir or STATE_DIRECTORY)")
+                                   : " at " + file.string()) +
+                     ": map first, or place one with `omnislam map save RUN_DIR " +
+                     (file.empty() ? std::string("STATE_DIR/state.omnisnap") : file.string()) + "`");
+  }
+  return snapshot;
+}
+
+// Counts of the frames that reached the sinks (publish thread), continued from a resumed
+// snapshot. The atomics are read by the main thread for STATUS.
+struct FrameCounts {
+  io::SnapshotCounters totals;
+  std::atomic<std::uint64_t> skipped{0};
+  std::atomic<std::uint64_t> without_odometry{0};
+  bool in_odometry_gap = false;
+};
+
+io::Snapshot make_snapshot(const pipeline::Frame &frame, const io::SnapshotCounters &counters,
+                           std::uint64_t config_hash) {
+  io::Snapshot s;
+  s.config_hash = config_hash;
+  s.t_s = frame.stamp_s;
+  s.T_map_base = frame.estimate.T_map_base;
+  s.covariance = frame.estimate.covariance;
+  if (frame.has_odometry) s.T_odom_base = frame.T_odom_base;
+  s.counters = counters;
+  s.map_integrations = frame.map_integrations;
+  s.points = *frame.map;
+  return s;
+}
+
 // SIGINT/SIGTERM are blocked in every thread and taken here, on the main thread, which
-// then drains the pipeline.
-bool wait_for_signal_or(const pipeline::Pipeline &pipeline, const sigset_t &signals) {
+// meanwhile pets the watchdog while no stage hangs and reports STATUS. Returns true on a
+// signal, false when the input ended.
+bool supervise(const pipeline::Pipeline &pipeline, const sigset_t &signals, const SystemdNotifier &notifier,
+               double stage_timeout_s, const FrameCounts &counts) {
   const timespec tick{0, 100'000'000};
+  const auto stage_timeout =
+      std::chrono::duration_cast<pipeline::Clock::duration>(std::chrono::duration<double>(stage_timeout_s));
+  const auto pet_every = notifier.watchdog_interval() / 2;
+  auto last_status = std::chrono::steady_clock::now();
+  auto last_pet = last_status - pet_every;  // pet at once
+  std::optional<std::size_t> hung;
   while (!pipeline.finished()) {
+    const auto now = std::chrono::steady_clock::now();
+    const std::optional<std::size_t> stuck = pipeline.stuck_stage(stage_timeout);
+    if (stuck && !hung) {
+      spdlog::error("the {} stage has been busy with one frame for more than {} s: it hangs{}",
+                    pipeline::Pipeline::kThreads[*stuck], stage_timeout_s,
+                    notifier.watchdog_enabled() ? "; the systemd watchdog is no longer petted" : "");
+      notifier.status(std::string("hung in the ") + std::string(pipeline::Pipeline::kThreads[*stuck]) +
+                      " stage");
+    } else if (!stuck && hung) {
+      spdlog::warn("the {} stage moves again", pipeline::Pipeline::kThreads[*hung]);
+    }
+    hung = stuck;
+    if (!hung && notifier.watchdog_enabled() && now - last_pet >= pet_every) {
+      notifier.watchdog();
+      last_pet = now;
+    }
+    if (!hung && now - last_status >= std::chrono::seconds(1)) {
+      notifier.status("running: frames in " + std::to_string(pipeline.frames_captured()) + ", out " +
+                      std::to_string(pipeline.frames_out()) + ", dropped " +
+                      std::to_string(pipeline.frames_dropped()) + ", skipped " +
+                      std::to_string(counts.skipped.load(std::memory_order_relaxed)) + ", without odometry " +
+                      std::to_string(counts.without_odometry.load(std::memory_order_relaxed)));
+      last_status = now;
+    }
     const int signal = sigtimedwait(&signals, nullptr, &tick);
     if (signal > 0) {
       spdlog::info("signal {}: draining the pipeline", signal);
@@ -42,20 +189,18 @@ bool wait_for_signal_or(const pipeline::Pipeline &pipeline, const sigset_t &sign
   return false;
 }
 
-pipeline::PipelineConfig pipeline_config(const io::PipelineSectionConfig &section, double rate_hz) {
-  pipeline::PipelineConfig config;
-  config.mode = section.mode == "replay" ? pipeline::Mode::kReplay : pipeline::Mode::kLive;
-  config.queue_capacity = static_cast<std::size_t>(section.queue_capacity);
-  config.input_rate_hz = rate_hz;
-  config.map_period_s = section.map_rate_hz > 0.0 ? 1.0 / section.map_rate_hz : 0.0;
-  config.profile_period_s = section.profile_period_s;
-  config.profile_window = static_cast<std::size_t>(section.profile_window);
-  return config;
-}
-
 int run_service(const std::string &config_file) {
   io::Config config = io::load_config(config_file);
   const io::ServiceConfig &service = config.service;
+  if (service.input.odometry == "none" && config.slam.use_odometry) {
+    spdlog::info("input.odometry is none: SLAM without odometry (thesis sec. 5.2)");
+    config.slam.use_odometry = false;
+  }
+  const std::uint64_t config_hash = io::config_file_hash(config_file);
+  const std::filesystem::path snapshot_file = state_file(config.persistence);
+  if (snapshot_file.empty())
+    spdlog::warn("no persistence.state_dir and no STATE_DIRECTORY: the map is not saved");
+  const std::optional<io::Snapshot> resumed = resume_state(config, snapshot_file, config_hash);
 
   sigset_t signals;
   sigemptyset(&signals);
@@ -76,7 +221,8 @@ int run_service(const std::string &config_file) {
   dds::StatusMessage status{system_time_s(), dds::ServiceState::kStarting, 0, 0, 0, ""};
   if (publisher) publisher->status(status);
 
-  const ServiceInput input = make_service_input(config, odometry);
+  const ServiceInput input =
+      make_service_input(config, odometry, resumed ? resumed->t_s : -std::numeric_limits<double>::infinity());
   spdlog::info("input: {}, {} Hz, mode {}, DDS domain {}", input.description, input.rate_hz,
                service.pipeline.mode, service.dds.enabled ? std::to_string(service.dds.domain_id) : "off");
   if (publisher && service.dds.wait_for_subscribers > 0 &&
@@ -85,10 +231,41 @@ int run_service(const std::string &config_file) {
                  service.dds.wait_for_subscribers, service.dds.wait_timeout_s);
   }
 
+  std::optional<SnapshotWriter> snapshots;
+  if (!snapshot_file.empty()) {
+    std::filesystem::create_directories(snapshot_file.parent_path());
+    snapshots.emplace(snapshot_file);
+  }
+  FrameCounts counts;
+  if (resumed) counts.totals = resumed->counters;
+  const bool expects_odometry = service.input.odometry != "none";
+
   RunRecord run;
+  std::optional<FrameRecord> last_frame;  // for the final snapshot
   pipeline::Sinks sinks;
   sinks.frame = [&](const pipeline::Frame &frame) {
-    if (frame.skipped()) spdlog::warn("frame {} skipped: {}", frame.sequence, frame.error);
+    io::SnapshotCounters &n = counts.totals;
+    ++n.frames;
+    n.dropped += frame.dropped_before;
+    if (frame.skipped()) {
+      ++n.skipped;
+      counts.skipped.fetch_add(1, std::memory_order_relaxed);
+      spdlog::warn("frame {} skipped: {}", frame.sequence, frame.error);
+    }
+    (frame.estimate.integrated ? n.integrated : n.not_integrated) += 1;
+    if (expects_odometry && !frame.has_odometry) {
+      counts.without_odometry.fetch_add(1, std::memory_order_relaxed);
+      if (!counts.in_odometry_gap) {
+        spdlog::warn(
+            "frame {} (t {:.3f} s) has no odometry ({} has no sample close enough): predicted with "
+            "the last motion, not added to the map, until odometry returns",
+            frame.sequence, frame.stamp_s, service.input.odometry_topic);
+      }
+      counts.in_odometry_gap = true;
+    } else if (counts.in_odometry_gap && frame.has_odometry) {
+      spdlog::info("odometry is back at frame {}", frame.sequence);
+      counts.in_odometry_gap = false;
+    }
     if (frame.dropped_before > 0)
       spdlog::debug("{} frames dropped before frame {}", frame.dropped_before, frame.sequence);
     if (publisher) {
@@ -96,7 +273,9 @@ int run_service(const std::string &config_file) {
       publisher->scan(frame.stamp_s, frame.scan);
       if (frame.map) publisher->map(frame.stamp_s, *frame.map);
     }
-    if (!service.output_dir.empty()) run.frames.push_back(frame_record(frame));
+    if (frame.state_due && snapshots) snapshots->submit(make_snapshot(frame, n, config_hash));
+    last_frame = frame_record(frame);
+    if (!service.output_dir.empty()) run.frames.push_back(*last_frame);
   };
   sinks.profile = [&](const pipeline::ProfileSnapshot &profile) {
     if (publisher) publisher->profile(system_time_s(), profile);
@@ -105,14 +284,23 @@ int run_service(const std::string &config_file) {
                  profile.latency.p99_ms);
   };
 
-  pipeline::Pipeline pipeline(config.scan, config.slam, pipeline_config(service.pipeline, input.rate_hz),
+  pipeline::Pipeline pipeline(config.scan, config.slam,
+                              pipeline_config(config, input.rate_hz, snapshots.has_value()),
                               std::move(sinks));
+  if (resumed) {
+    pipeline.resume(resumed->points, resumed->map_integrations, resumed->T_map_base, resumed->covariance,
+                    resumed->T_odom_base);
+  }
   pipeline.start(input.source);
   status.state = dds::ServiceState::kRunning;
   status.stamp_s = system_time_s();
   if (publisher) publisher->status(status);
+  const SystemdNotifier notifier;
+  notifier.ready("running: " + input.description);
 
-  if (wait_for_signal_or(pipeline, signals)) {
+  const bool signalled = supervise(pipeline, signals, notifier, service.stage_timeout_s, counts);
+  notifier.stopping(signalled ? "stopping: draining the pipeline" : "stopping: the input ended");
+  if (signalled) {
     status.state = dds::ServiceState::kStopping;
     status.stamp_s = system_time_s();
     if (publisher) publisher->status(status);
@@ -126,7 +314,24 @@ int run_service(const std::string &config_file) {
   status.frames_dropped = pipeline.frames_dropped();
   status.last_error = pipeline.error();
   status.state = pipeline.error().empty() ? dds::ServiceState::kStopped : dds::ServiceState::kFailed;
-  const double last_stamp = run.frames.empty() ? status.stamp_s : run.frames.back().t_s;
+  const double last_stamp = last_frame ? last_frame->t_s : status.stamp_s;
+  if (snapshots && last_frame) {
+    // The final state, written before anything else can fail.
+    pipeline::Frame last;
+    last.stamp_s = last_frame->t_s;
+    last.estimate.T_map_base = last_frame->T_map_base;
+    last.estimate.covariance = last_frame->covariance;
+    last.T_odom_base = last_frame->T_odom_base;
+    last.has_odometry = last_frame->has_odometry;
+    last.map_integrations = pipeline.slam().map().integrations();
+    last.map = std::make_shared<const std::vector<slam::MapPoint>>(pipeline.slam().map().points());
+    snapshots->submit(make_snapshot(last, counts.totals, config_hash));
+  }
+  if (snapshots) {
+    snapshots->finish();
+    if (!snapshots->last_error().empty()) status.last_error = snapshots->last_error();
+    spdlog::info("{} snapshots written to {}", snapshots->written(), snapshots->file().string());
+  }
   if (publisher) {
     publisher->map(last_stamp, pipeline.slam().map().points());  // the final state
     publisher->status(status);
@@ -139,8 +344,9 @@ int run_service(const std::string &config_file) {
       run.odometry_map.push_back(run.frames.front().T_odom_base.inverse() * f.T_odom_base);
     OutputWriter(service.output_dir).write_all(run, pipeline.slam().map(), info);
   }
-  spdlog::info("stopped: {} frames in, {} out, {} dropped", status.frames_in, status.frames_out,
-               status.frames_dropped);
+  spdlog::info("stopped: {} frames in, {} out, {} dropped, {} skipped, {} without odometry", status.frames_in,
+               status.frames_out, status.frames_dropped, counts.skipped.load(),
+               counts.without_odometry.load());
   if (!pipeline.error().empty()) {
     spdlog::error("{}", pipeline.error());
     return 1;
@@ -163,7 +369,10 @@ int main(int argc, char **argv) {
     return run_service(config_file);
   } catch (const io::ConfigError &error) {
     spdlog::critical("configuration error: {}", error.what());
-    return 2;
+    return kExitConfig;
+  } catch (const StateError &error) {
+    spdlog::critical("cannot start from the saved state: {}", error.what());
+    return kExitState;
   } catch (const std::exception &error) {
     spdlog::critical("{}", error.what());
     return 1;

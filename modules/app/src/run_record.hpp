@@ -18,6 +18,7 @@ struct FrameRecord {
   double t_s = 0.0;
   Eigen::Isometry2d T_map_base = Eigen::Isometry2d::Identity();
   Eigen::Isometry2d T_odom_base = Eigen::Isometry2d::Identity();  ///< the odometry used
+  bool has_odometry = true;  ///< false: odometry had a gap at this frame (T_odom_base is meaningless)
   Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
   bool skipped = false;  ///< the image could not be used
   bool integrated = false;

@@ -75,7 +75,8 @@ pipeline::FrameSource capture_source(std::shared_ptr<cv::VideoCapture> capture,
 
 }  // namespace
 
-ServiceInput make_service_input(io::Config &config, std::shared_ptr<dds::OdometryReader> odometry) {
+ServiceInput make_service_input(io::Config &config, std::shared_ptr<dds::OdometryReader> odometry,
+                                double resume_after_s) {
   const io::InputConfig &input = config.service.input;
   if (input.odometry != "dds") odometry.reset();
   ServiceInput result;
@@ -92,6 +93,7 @@ ServiceInput make_service_input(io::Config &config, std::shared_ptr<dds::Odometr
       throw std::runtime_error(info.odometry.string() + ": too few poses");
     DatasetSourceOptions options;
     options.loops = input.loops;
+    options.after_s = resume_after_s;
     result.source = dataset_source(info, std::move(poses), config.scan.camera, std::move(options));
     result.description = "dataset " + info.dir.string();
   } else if (input.source == "directory") {

@@ -18,9 +18,12 @@ struct ServiceInput {
 };
 
 /// Builds the source. `config.scan.camera` is updated from a dataset's own camera.
-/// `odometry` is used (on the capture thread only) when input.odometry is dds.
+/// `odometry` is used (on the capture thread only) when input.odometry is dds. A dataset
+/// starts after `resume_after_s` (the time of the snapshot the service resumed from);
+/// live sources are stamped with the clock and need no such cut.
 /// Throws std::runtime_error naming the path or device that cannot be opened.
 [[nodiscard]] ServiceInput make_service_input(io::Config &config,
-                                              std::shared_ptr<dds::OdometryReader> odometry);
+                                              std::shared_ptr<dds::OdometryReader> odometry,
+                                              double resume_after_s);
 
 }  // namespace omnislam::app

@@ -193,6 +193,8 @@ Config load_config(const std::filesystem::path &file) {
   read_section(top, "stereo", name, [&](YamlSection &stereo) { read_stereo(stereo, config.scan.stereo); });
   read_section(top, "slam", name, [&](YamlSection &slam) { read_slam(slam, config.slam); });
   read_section(top, "persistence", name, [&](YamlSection &persistence) {
+    persistence.read("state_dir", config.persistence.state_dir);
+    persistence.read("resume", config.persistence.resume);
     persistence.read("snapshot_period_s", config.persistence.snapshot_period_s);
     if (config.persistence.snapshot_period_s < 0.0) persistence.fail("snapshot_period_s", "must be >= 0");
     read_choice(persistence, "on_corrupt_snapshot", config.persistence.refuse_corrupt_snapshot,

@@ -67,8 +67,11 @@ void read_service_sections(YamlSection &top, const std::string &file, ServiceCon
   read_section(top, "pipeline", file,
                [&](YamlSection &section) { read_pipeline(section, service.pipeline); });
   read_section(top, "dds", file, [&](YamlSection &section) { read_dds(section, service.dds); });
-  read_section(top, "service", file,
-               [&](YamlSection &section) { section.read("output_dir", service.output_dir); });
+  read_section(top, "service", file, [&](YamlSection &section) {
+    section.read("output_dir", service.output_dir);
+    section.read("stage_timeout_s", service.stage_timeout_s);
+    if (!(service.stage_timeout_s > 0.0)) section.fail("stage_timeout_s", "must be positive");
+  });
 }
 
 }  // namespace omnislam::io::detail

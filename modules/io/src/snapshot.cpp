@@ -276,7 +276,7 @@ ResumeResult resume_from_snapshot(const std::filesystem::path &file, CorruptSnap
   } catch (const SnapshotError &corrupt) {
     if (policy == CorruptSnapshotPolicy::kRefuse) {
       throw SnapshotError(std::string(corrupt.what()) +
-                          "; refusing to start (persistence.on_corrupt: refuse)");
+                          "; refusing to start (persistence.on_corrupt_snapshot: refuse)");
     }
     result.moved_aside_to = move_aside(file);
     result.message =

@@ -54,6 +54,13 @@ Pipeline::~Pipeline() {
   join();
 }
 
+void Pipeline::resume(std::vector<slam::MapPoint> points, int integrations,
+                      const Eigen::Isometry2d &T_map_base, const Eigen::Matrix3d &covariance,
+                      const std::optional<Eigen::Isometry2d> &T_odom_base) {
+  if (started_) throw std::logic_error("Pipeline::resume after start");
+  slam_.resume(std::move(points), integrations, T_map_base, covariance, T_odom_base);
+}
+
 void Pipeline::start(FrameSource source) {
   if (started_) throw std::logic_error("Pipeline::start called twice");
   started_ = true;
@@ -95,6 +102,11 @@ std::optional<std::size_t> Pipeline::stuck_stage(Clock::duration limit) const {
 
 void Pipeline::busy(std::size_t thread, bool is_busy) {
   busy_since_ns_[thread].store(is_busy ? now_ns() : 0, std::memory_order_relaxed);
+}
+
+void Pipeline::stall_if_asked(std::size_t thread, const Frame &frame) const {
+  if (thread != config_.stall_thread || frame.sequence != config_.stall_at_frame) return;
+  while (!stop_.load(std::memory_order_relaxed)) std::this_thread::sleep_for(std::chrono::milliseconds(10));
 }
 
 void Pipeline::fail(std::string &slot, const std::string &message) {
@@ -167,6 +179,7 @@ void Pipeline::frontend_loop() {
   FramePtr frame;
   while (take(queues_[kFrontend], kFrontend, frame)) {
     busy(1, true);
+    stall_if_asked(1, *frame);
     if (!frame->skipped() && !frontend.accepts(frame->image)) {
       frame->error = "not an 8-bit grey image of the camera size";
     }
@@ -192,6 +205,7 @@ void Pipeline::stereo_loop() {
   FramePtr frame;
   while (take(queues_[kStereo], kStereo, frame)) {
     busy(2, true);
+    stall_if_asked(2, *frame);
     if (!frame->skipped()) {
       StepClock clock(*frame);
       matcher.swap_lobes(frame->inner, frame->outer);
@@ -210,15 +224,17 @@ void Pipeline::stereo_loop() {
 
 void Pipeline::slam_loop() {
   Clock::time_point last_map = Clock::time_point::min();
+  Clock::time_point last_state = Clock::now();
   FramePtr frame;
   while (take(queues_[kSlamQueue], kSlamQueue, frame)) {
     busy(3, true);
+    stall_if_asked(3, *frame);
     StepClock clock(*frame);
     frame->estimate = slam_.process(scan_points(frame->scan),
                                     frame->has_odometry ? std::optional(frame->T_odom_base) : std::nullopt);
     clock.lap(kSlam);
+    const Clock::time_point now = Clock::now();
     if (frame->estimate.integrated) {
-      const Clock::time_point now = Clock::now();
       const bool due = config_.map_period_s > 0.0 &&
                        (last_map == Clock::time_point::min() ||
                         now - last_map >= std::chrono::duration<double>(config_.map_period_s));
@@ -227,6 +243,13 @@ void Pipeline::slam_loop() {
         last_map = now;
       }
     }
+    if (config_.state_period_s > 0.0 &&
+        now - last_state >= std::chrono::duration<double>(config_.state_period_s)) {
+      if (!frame->map) frame->map = std::make_shared<const std::vector<slam::MapPoint>>(slam_.map().points());
+      frame->state_due = true;
+      last_state = now;
+    }
+    if (frame->map) frame->map_integrations = slam_.map().integrations();
     busy(3, false);
     forward(queues_[kPublish], frame);
   }
@@ -261,6 +284,7 @@ void Pipeline::publish_loop() {
       frame->timings.latency_ms = ms_between(frame->captured, now);
       profiler.add(frame->timings);
       busy(4, true);
+      stall_if_asked(4, *frame);
       try {
         if (sinks_.frame) sinks_.frame(*frame);
       } catch (const std::exception &error) {

@@ -29,7 +29,7 @@
 ///            use_odometry, no_odometry_min_srel_percent, no_odometry_max_rotation_deg, fusion_radius_m,
 ///            noise_radius_m, noise_min_neighbors, prune_every, prune_min_hits, prune_min_age,
 ///            localization_only}
-/// persistence: {snapshot_period_s, on_corrupt_snapshot: start_fresh | refuse}
+/// persistence: {state_dir, resume, snapshot_period_s, on_corrupt_snapshot: start_fresh | refuse}
 /// input, pipeline, dds, service: omnislamd's sections (service_config.hpp)
 /// ```
 /// The field meanings are documented on the structs (vision_config.hpp, stereo_config.hpp, slam.hpp).
@@ -46,6 +46,10 @@ class ConfigError : public std::runtime_error {
 
 /// State persistence of the service (io/snapshot.hpp).
 struct PersistenceConfig {
+  /// Where the snapshot (state.omnisnap) lives; empty: $STATE_DIRECTORY (systemd's
+  /// StateDirectory), and without it no persistence.
+  std::string state_dir;
+  bool resume = true;                    ///< continue from the snapshot at start (false: a new map)
   double snapshot_period_s = 30.0;       ///< how often the map and pose are saved; 0 = only at shutdown
   bool refuse_corrupt_snapshot = false;  ///< false: a corrupt snapshot is moved aside and a new map started
 };

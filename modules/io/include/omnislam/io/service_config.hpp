@@ -11,7 +11,7 @@
 ///            odometry: dataset | dds | none, odometry_topic}
 /// pipeline: {mode: live | replay, queue_capacity, map_rate_hz, profile_period_s, profile_window}
 /// dds:      {enabled, domain_id, config, wait_for_subscribers, wait_timeout_s}
-/// service:  {output_dir}
+/// service:  {output_dir, stage_timeout_s}
 /// ```
 
 namespace omnislam::io {
@@ -54,6 +54,9 @@ struct ServiceConfig {
   PipelineSectionConfig pipeline;
   DdsSectionConfig dds;
   std::string output_dir;  ///< trajectory.tum, profile.csv, map.csv at shutdown; empty: none
+  /// A stage busy with one frame for longer is hung: the service stops petting the systemd
+  /// watchdog (WatchdogSec), which then restarts it.
+  double stage_timeout_s = 5.0;
 };
 
 }  // namespace omnislam::io

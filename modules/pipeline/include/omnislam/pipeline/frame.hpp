@@ -58,8 +58,11 @@ struct Frame {
   stereo::LobeWork outer;
   stereo::LocalScan scan;        ///< base_link, metres
   slam::FrameEstimate estimate;  ///< pose in the map frame
-  /// The map after this frame, when the pipeline was asked for snapshots and it changed.
+  /// The map after this frame, when the pipeline was asked for snapshots and it changed,
+  /// or when state_due.
   std::shared_ptr<const std::vector<slam::MapPoint>> map;
+  int map_integrations = 0;  ///< slam::PointMap::integrations() of `map`
+  bool state_due = false;    ///< map is attached for a state snapshot (PipelineConfig::state_period_s)
 
   FrameTimings timings;
 

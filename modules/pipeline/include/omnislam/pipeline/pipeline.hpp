@@ -34,6 +34,14 @@ struct PipelineConfig {
   double map_period_s = 0.5;           ///< otherwise at most this often (<= 0: never)
   double profile_period_s = 1.0;       ///< profile sink period (wall clock)
   std::size_t profile_window = 300;    ///< frames in the rolling statistics
+  /// Attach the SLAM state (map and its integration count) to a frame at most this often,
+  /// marked Frame::state_due, for the service's snapshots (<= 0: never).
+  double state_period_s = 0.0;
+  /// Fault injection for the watchdog test: the stage thread with this index (1..4, see
+  /// Pipeline::kThreads; 0 = none) holds the frame with sequence `stall_at_frame` until
+  /// stop() is called, as a hung stage would.
+  std::size_t stall_thread = 0;
+  std::uint64_t stall_at_frame = 0;
 };
 
 /// Called on the capture thread for the next frame: fills stamp_s, image (or error) and
@@ -55,6 +63,11 @@ class Pipeline {
   Pipeline &operator=(const Pipeline &) = delete;
   /// Stops and joins.
   ~Pipeline();
+
+  /// Continues from a saved SLAM state (slam::Slam::resume) instead of a new map. Only
+  /// before start().
+  void resume(std::vector<slam::MapPoint> points, int integrations, const Eigen::Isometry2d &T_map_base,
+              const Eigen::Matrix3d &covariance, const std::optional<Eigen::Isometry2d> &T_odom_base);
 
   /// Starts the five threads. Call once.
   void start(FrameSource source);
@@ -98,6 +111,7 @@ class Pipeline {
   void emit_profile(const Profiler &profiler);
   void fail(std::string &slot, const std::string &message);
   void busy(std::size_t thread, bool is_busy);
+  void stall_if_asked(std::size_t thread, const Frame &frame) const;
 
   stereo::ScanConfig scan_config_;
   PipelineConfig config_;
