@@ -136,6 +136,12 @@ TEST_CASE("config: persistence and localization keys", "[io][config]") {
   CHECK(defaults.persistence.resume);
   CHECK(defaults.persistence.state_dir.empty());
   CHECK(defaults.service.stage_timeout_s == 5.0);
+  CHECK(defaults.service.input.odometry_max_gap_s == 0.5);
+  CHECK(defaults.service.input.odometry_max_extrapolation_s == 0.2);
+  CHECK_THROWS_WITH(omnislam::io::load_config(write_file("gap.yaml",
+                                                         "input: {source: camera, odometry: dds, "
+                                                         "odometry_max_gap_s: 0}\n")),
+                    Catch::Contains("'input.odometry_max_gap_s' must be positive"));
   CHECK_THROWS_WITH(omnislam::io::load_config(write_file("stage.yaml", "service:\n  stage_timeout_s: 0\n")),
                     Catch::EndsWith("stage.yaml:2:20: 'service.stage_timeout_s' must be positive"));
   CHECK_THROWS_WITH(omnislam::io::load_config(write_file("resume.yaml", "persistence: {resume: maybe}\n")),

@@ -125,7 +125,11 @@ def test_a_hung_stage_stops_the_watchdog(tmp_path):
         config = write_config(tmp_path / "c.yaml", extra="service: {stage_timeout_s: 0.5}\n", loops=100)
         service = start(config, {"NOTIFY_SOCKET": str(notify.path), "WATCHDOG_USEC": "1000000",
                                  "OMNISLAM_TEST_STALL": "slam:12"})
-        time.sleep(4.0)  # frame 12 reaches SLAM after ~1.1 s, is declared hung 0.5 s later
+        # Frame 12 reaches SLAM ~1.1 s after READY and is declared hung 0.5 s later.
+        deadline = time.monotonic() + 30
+        while not notify.lines("STATUS=hung") and time.monotonic() < deadline:
+            time.sleep(0.05)
+        time.sleep(2.5)  # five watchdog periods without a ping
         service.send_signal(signal.SIGTERM)  # the stalled stage lets go on stop
         log, _ = service.communicate(timeout=30)
         assert service.returncode == 0, log

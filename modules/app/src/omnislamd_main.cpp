@@ -215,7 +215,9 @@ int run_service(const std::string &config_file) {
     participant.emplace(dds::DdsConfig{service.dds.domain_id, service.dds.config});
     publisher.emplace(*participant);
     if (service.input.odometry == "dds") {
-      odometry = std::make_shared<dds::OdometryReader>(*participant, service.input.odometry_topic);
+      odometry = std::make_shared<dds::OdometryReader>(
+          *participant, service.input.odometry_topic,
+          dds::OdometryLookup{service.input.odometry_max_extrapolation_s, service.input.odometry_max_gap_s});
     }
   }
   dds::StatusMessage status{system_time_s(), dds::ServiceState::kStarting, 0, 0, 0, ""};
@@ -344,6 +346,9 @@ int run_service(const std::string &config_file) {
       run.odometry_map.push_back(run.frames.front().T_odom_base.inverse() * f.T_odom_base);
     OutputWriter(service.output_dir).write_all(run, pipeline.slam().map(), info);
   }
+  if (odometry && odometry->rejected() > 0)
+    spdlog::warn("{} odometry samples on {} had a non-finite stamp or pose and were dropped",
+                 odometry->rejected(), service.input.odometry_topic);
   spdlog::info("stopped: {} frames in, {} out, {} dropped, {} skipped, {} without odometry", status.frames_in,
                status.frames_out, status.frames_dropped, counts.skipped.load(),
                counts.without_odometry.load());

@@ -30,6 +30,10 @@ void read_input(YamlSection &section, InputConfig &input) {
   section.read("loops", input.loops);
   read_one_of(section, "odometry", input.odometry, {"dataset", "dds", "none"});
   section.read("odometry_topic", input.odometry_topic);
+  section.read("odometry_max_extrapolation_s", input.odometry_max_extrapolation_s);
+  section.read("odometry_max_gap_s", input.odometry_max_gap_s);
+  if (input.odometry_max_extrapolation_s < 0.0) section.fail("odometry_max_extrapolation_s", "must be >= 0");
+  if (!(input.odometry_max_gap_s > 0.0)) section.fail("odometry_max_gap_s", "must be positive");
   if (input.loops < 1) section.fail("loops", "must be at least 1");
   if (input.source != "camera" && input.path.empty()) section.fail("source", "needs input.path");
   if (input.odometry == "dataset" && input.source != "dataset") {

@@ -2,10 +2,10 @@
 
 #include <Eigen/Geometry>
 #include <cstdint>
-#include <deque>
 #include <optional>
 #include <string>
 
+#include "omnislam/dds/odometry_buffer.hpp"
 #include "omnislam/dds/participant.hpp"
 
 /// @file
@@ -18,26 +18,25 @@ namespace omnislam::dds {
 class OdometryReader {
  public:
   explicit OdometryReader(const Participant &participant, const std::string &topic = "rt/odom",
-                          std::size_t keep = 2000);
+                          OdometryLookup lookup = {}, std::size_t keep = 2000);
 
   /// Takes the samples that arrived since the last call; returns how many.
   std::size_t poll();
 
-  /// The odometry pose (x, y, yaw of child in the odom frame) at `stamp_s`: interpolated
-  /// between the samples around it, or the newest one when stamp_s is at most
-  /// `max_extrapolation_s` after it. Empty when nothing fits.
-  [[nodiscard]] std::optional<Eigen::Isometry2d> at(double stamp_s, double max_extrapolation_s = 0.2) const;
+  /// The odometry pose at `stamp_s` (OdometryBuffer::at); empty in a gap of the stream.
+  [[nodiscard]] std::optional<Eigen::Isometry2d> at(double stamp_s) const {
+    return buffer_.at(stamp_s, lookup_);
+  }
 
-  [[nodiscard]] std::size_t size() const { return samples_.size(); }
+  [[nodiscard]] std::size_t size() const { return buffer_.size(); }
+  /// Samples dropped for a non-finite stamp or pose.
+  [[nodiscard]] std::size_t rejected() const { return rejected_; }
 
  private:
-  struct Sample {
-    double stamp_s;
-    double x_m, y_m, yaw_rad;
-  };
   std::int32_t reader_ = 0;
-  std::size_t keep_;
-  std::deque<Sample> samples_;  ///< ordered by stamp
+  OdometryLookup lookup_;
+  OdometryBuffer buffer_;
+  std::size_t rejected_ = 0;
 };
 
 }  // namespace omnislam::dds

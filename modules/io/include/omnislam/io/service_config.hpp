@@ -8,7 +8,8 @@
 ///
 /// ```yaml
 /// input:    {source: directory | dataset | camera | video, path, device, rate_hz, loops,
-///            odometry: dataset | dds | none, odometry_topic}
+///            odometry: dataset | dds | none, odometry_topic, odometry_max_extrapolation_s,
+///            odometry_max_gap_s}
 /// pipeline: {mode: live | replay, queue_capacity, map_rate_hz, profile_period_s, profile_window}
 /// dds:      {enabled, domain_id, config, wait_for_subscribers, wait_timeout_s}
 /// service:  {output_dir, stage_timeout_s}
@@ -31,6 +32,11 @@ struct InputConfig {
   /// (nav_msgs Odometry on odometry_topic) or none.
   std::string odometry = "dataset";
   std::string odometry_topic = "rt/odom";
+  /// dds odometry: a frame up to this long after the newest sample takes that sample ...
+  double odometry_max_extrapolation_s = 0.2;
+  /// ... and two samples further apart than this are a gap: frames in a gap have no
+  /// odometry (SLAM predicts them from the last motion and keeps them out of the map).
+  double odometry_max_gap_s = 0.5;
 };
 
 struct PipelineSectionConfig {
