@@ -126,6 +126,7 @@ struct FrameCounts {
   io::SnapshotCounters totals;
   std::atomic<std::uint64_t> skipped{0};
   std::atomic<std::uint64_t> without_odometry{0};
+  std::atomic<std::size_t> map_points{0};  ///< of the last map attached to a frame
   bool in_odometry_gap = false;
 };
 
@@ -177,7 +178,8 @@ bool supervise(const pipeline::Pipeline &pipeline, const sigset_t &signals, cons
                       std::to_string(pipeline.frames_out()) + ", dropped " +
                       std::to_string(pipeline.frames_dropped()) + ", skipped " +
                       std::to_string(counts.skipped.load(std::memory_order_relaxed)) + ", without odometry " +
-                      std::to_string(counts.without_odometry.load(std::memory_order_relaxed)));
+                      std::to_string(counts.without_odometry.load(std::memory_order_relaxed)) + "; map " +
+                      std::to_string(counts.map_points.load(std::memory_order_relaxed)) + " points");
       last_status = now;
     }
     const int signal = sigtimedwait(&signals, nullptr, &tick);
@@ -275,15 +277,16 @@ int run_service(const std::string &config_file) {
       publisher->scan(frame.stamp_s, frame.scan);
       if (frame.map) publisher->map(frame.stamp_s, *frame.map);
     }
+    if (frame.map) counts.map_points.store(frame.map->size(), std::memory_order_relaxed);
     if (frame.state_due && snapshots) snapshots->submit(make_snapshot(frame, n, config_hash));
     last_frame = frame_record(frame);
     if (!service.output_dir.empty()) run.frames.push_back(*last_frame);
   };
   sinks.profile = [&](const pipeline::ProfileSnapshot &profile) {
     if (publisher) publisher->profile(system_time_s(), profile);
-    spdlog::info("frames in {} out {} dropped {}; latency p50 {:.1f} ms p99 {:.1f} ms",
+    spdlog::info("frames in {} out {} dropped {}; latency p50 {:.1f} ms p99 {:.1f} ms; map {} points",
                  profile.frames_captured, profile.frames_out, profile.frames_dropped, profile.latency.p50_ms,
-                 profile.latency.p99_ms);
+                 profile.latency.p99_ms, counts.map_points.load(std::memory_order_relaxed));
   };
 
   pipeline::Pipeline pipeline(config.scan, config.slam,
