@@ -108,3 +108,30 @@ def test_sigterm_drains_publishes_final_state_and_exits_0(tmp_path):
     assert 10 <= frames_out < 37 * 100
     trajectory = (tmp_path / "service" / "trajectory.tum").read_text().splitlines()
     assert len(trajectory) - 1 == frames_out  # every captured frame drained to the files
+
+
+def test_omnislam_echo_prints_pose_and_status(tmp_path):
+    domain = domain_id(2)
+    echo = [os.environ["OMNISLAM_BIN"], "echo", "--domain", str(domain)]
+    poses = subprocess.Popen(echo + ["omnislam/pose", "--count", "3", "--timeout", "60"], stdout=subprocess.PIPE,
+                             stderr=subprocess.PIPE, text=True, env=dds_env())
+    status = subprocess.Popen(echo + ["rt/omnislam/status", "--timeout", "60"], stdout=subprocess.PIPE,
+                              stderr=subprocess.PIPE, text=True, env=dds_env())
+    config = write_config(tmp_path / "omnislamd.yaml", domain, tmp_path / "service", rate_hz=20)
+    service = subprocess.run([os.environ["OMNISLAMD_BIN"], "--config", str(config)], capture_output=True, text=True,
+                             env=dds_env(), timeout=120)
+    assert service.returncode == 0, service.stderr + service.stdout
+    out, err = poses.communicate(timeout=60)
+    assert poses.returncode == 0, err
+    expected = read_tum(tmp_path / "service" / "trajectory.tum")
+    lines = out.splitlines()
+    assert [line.split()[1] for line in lines] == ["stamp=0.000000000", "stamp=0.100000000", "stamp=0.200000000"]
+    for line in lines:
+        fields = dict(f.split("=", 1) for f in line.split()[1:])
+        ex, ey, _ = expected[round(float(fields["stamp"]), 6)]
+        assert fields["frame"] == "map"
+        assert abs(float(fields["x"]) - ex) < 1e-6 and abs(float(fields["y"]) - ey) < 1e-6
+    time.sleep(1.0)
+    status.send_signal(signal.SIGINT)
+    out, _ = status.communicate(timeout=30)
+    assert 'state=stopped in=37 out=37 dropped=0 error=""' in out.splitlines()[-1]
