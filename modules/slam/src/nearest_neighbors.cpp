@@ -69,6 +69,18 @@ std::size_t NearestNeighbors::count_within(const Point2 &query, double radius_m)
   return index_->tree.radiusSearch(query.data(), radius_m * radius_m, found, params);
 }
 
+std::vector<std::size_t> NearestNeighbors::within(const Point2 &query, double radius_m) const {
+  std::vector<std::size_t> indices;
+  if (!index_) return indices;
+  std::vector<std::pair<std::size_t, double>> found;
+  nanoflann::SearchParams params;
+  params.sorted = false;
+  index_->tree.radiusSearch(query.data(), radius_m * radius_m, found, params);
+  indices.reserve(found.size());
+  for (const auto &neighbor : found) indices.push_back(neighbor.first);
+  return indices;
+}
+
 const Point2 &NearestNeighbors::normal(std::size_t index) const {
   constexpr double kNormalRadiusM = 0.15;
   if (normal_known_.empty()) {

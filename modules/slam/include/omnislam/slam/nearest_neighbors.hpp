@@ -44,6 +44,9 @@ class NearestNeighbors {
   /// Number of points within `radius_m` of `query` (the query itself counts if present).
   [[nodiscard]] std::size_t count_within(const Point2 &query, double radius_m) const;
 
+  /// Indices of the points within `radius_m` of `query`, in no particular order.
+  [[nodiscard]] std::vector<std::size_t> within(const Point2 &query, double radius_m) const;
+
  private:
   struct Index;
   Points2 points_;

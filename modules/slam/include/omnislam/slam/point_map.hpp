@@ -37,6 +37,10 @@ class PointMap {
 
   /// Fuses `points_map` (already in the map frame) into the map, filters noise and, every
   /// prune_every integrations, drops rarely seen points; then rebuilds the search index.
+  /// The noise filter gives the thesis's result (every map point checked) but checks only
+  /// where a neighbour count can have dropped since the last integration: around the new
+  /// scan (fused points move) and around the points removed last time. Elsewhere counts
+  /// can only have grown, so the cost follows the scan, not the map.
   void integrate(const Points2 &points_map);
 
   [[nodiscard]] const std::vector<MapPoint> &points() const { return points_; }
@@ -51,6 +55,8 @@ class PointMap {
   std::vector<MapPoint> points_;
   NearestNeighbors index_;
   int integrations_ = 0;
+  bool check_all_ = false;        ///< the next noise filter checks every point (a restored map)
+  Points2 removed_since_filter_;  ///< positions of the points removed after the last filter
 };
 
 }  // namespace omnislam::slam
