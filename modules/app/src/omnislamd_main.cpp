@@ -5,10 +5,8 @@
 #include <spdlog/spdlog.h>
 
 #include <CLI/CLI.hpp>
-#include <atomic>
 #include <chrono>
 #include <csignal>
-#include <cstdio>
 #include <cstdlib>
 #include <exception>
 #include <filesystem>
@@ -20,12 +18,12 @@
 #include "omnislam/dds/odometry_reader.hpp"
 #include "omnislam/dds/publisher.hpp"
 #include "omnislam/io/config.hpp"
-#include "omnislam/io/snapshot.hpp"
 #include "omnislam/pipeline/pipeline.hpp"
 #include "run_outputs.hpp"
 #include "service_input.hpp"
+#include "service_state.hpp"
+#include "service_supervisor.hpp"
 #include "snapshot_writer.hpp"
-#include "systemd_notify.hpp"
 
 namespace {
 
@@ -37,11 +35,6 @@ using namespace omnislam::app;
 /// restart on either: the same start would fail the same way.
 constexpr int kExitConfig = 2;
 constexpr int kExitState = 3;
-
-class StateError : public std::runtime_error {
- public:
-  using std::runtime_error::runtime_error;
-};
 
 double system_time_s() {
   return std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
@@ -57,7 +50,7 @@ pipeline::PipelineConfig pipeline_config(const io::Config &config, double rate_h
   result.profile_period_s = section.profile_period_s;
   result.profile_window = static_cast<std::size_t>(section.profile_window);
   if (snapshots) result.state_period_s = config.persistence.snapshot_period_s;
-  // Fault injection for the watchdog test (tests/python/test_omnislamd_notify.py):
+  // Fault injection for the watchdog test (tests/python/test_omnislamd_service.py):
   // OMNISLAM_TEST_STALL=STAGE:FRAME holds that frame in that stage until shutdown.
   if (const char *stall = std::getenv("OMNISLAM_TEST_STALL")) {
     const std::string text(stall);
@@ -72,123 +65,6 @@ pipeline::PipelineConfig pipeline_config(const io::Config &config, double rate_h
     }
   }
   return result;
-}
-
-// persistence.state_dir, else systemd's $STATE_DIRECTORY; empty: no persistence.
-std::filesystem::path state_file(const io::PersistenceConfig &persistence) {
-  std::string dir = persistence.state_dir;
-  if (dir.empty()) {
-    const char *from_systemd = std::getenv("STATE_DIRECTORY");
-    if (from_systemd != nullptr)
-      dir = std::string(from_systemd).substr(0, std::string(from_systemd).find(':'));
-  }
-  return dir.empty() ? std::filesystem::path() : std::filesystem::path(dir) / "state.omnisnap";
-}
-
-std::optional<io::Snapshot> resume_state(const io::Config &config, const std::filesystem::path &file,
-                                         std::uint64_t config_hash) {
-  std::optional<io::Snapshot> snapshot;
-  if (!file.empty() && config.persistence.resume) {
-    const auto policy = config.persistence.refuse_corrupt_snapshot ? io::CorruptSnapshotPolicy::kRefuse
-                                                                   : io::CorruptSnapshotPolicy::kStartFresh;
-    io::ResumeResult resumed;
-    try {
-      resumed = io::resume_from_snapshot(file, policy);
-    } catch (const io::SnapshotError &error) {
-      throw StateError(error.what());
-    }
-    if (resumed.moved_aside_to.empty()) {
-      spdlog::info("{}", resumed.message);
-    } else {
-      spdlog::error("{}", resumed.message);
-    }
-    snapshot = std::move(resumed.snapshot);
-  }
-  if (snapshot && snapshot->config_hash != config_hash) {
-    spdlog::warn(
-        "the snapshot's map was built under another configuration (hash {:016x}, now {:016x}); "
-        "continuing with it",
-        snapshot->config_hash, config_hash);
-  }
-  if (config.slam.localization_only && !snapshot) {
-    throw StateError("slam.localization_only needs a saved map, and there is none" +
-                     (file.empty() ? std::string(" (no persistence.state_dir or STATE_DIRECTORY)")
-                                   : " at " + file.string()) +
-                     ": map first, or place one with `omnislam map save RUN_DIR " +
-                     (file.empty() ? std::string("STATE_DIR/state.omnisnap") : file.string()) + "`");
-  }
-  return snapshot;
-}
-
-// Counts of the frames that reached the sinks (publish thread), continued from a resumed
-// snapshot. The atomics are read by the main thread for STATUS.
-struct FrameCounts {
-  io::SnapshotCounters totals;
-  std::atomic<std::uint64_t> skipped{0};
-  std::atomic<std::uint64_t> without_odometry{0};
-  std::atomic<std::size_t> map_points{0};  ///< of the last map attached to a frame
-  bool in_odometry_gap = false;
-};
-
-io::Snapshot make_snapshot(const pipeline::Frame &frame, const io::SnapshotCounters &counters,
-                           std::uint64_t config_hash) {
-  io::Snapshot s;
-  s.config_hash = config_hash;
-  s.t_s = frame.stamp_s;
-  s.T_map_base = frame.estimate.T_map_base;
-  s.covariance = frame.estimate.covariance;
-  if (frame.has_odometry) s.T_odom_base = frame.T_odom_base;
-  s.counters = counters;
-  s.map_integrations = frame.map_integrations;
-  s.points = *frame.map;
-  return s;
-}
-
-// SIGINT/SIGTERM are blocked in every thread and taken here, on the main thread, which
-// meanwhile pets the watchdog while no stage hangs and reports STATUS. Returns true on a
-// signal, false when the input ended.
-bool supervise(const pipeline::Pipeline &pipeline, const sigset_t &signals, const SystemdNotifier &notifier,
-               double stage_timeout_s, const FrameCounts &counts) {
-  const timespec tick{0, 100'000'000};
-  const auto stage_timeout =
-      std::chrono::duration_cast<pipeline::Clock::duration>(std::chrono::duration<double>(stage_timeout_s));
-  const auto pet_every = notifier.watchdog_interval() / 2;
-  auto last_status = std::chrono::steady_clock::now();
-  auto last_pet = last_status - pet_every;  // pet at once
-  std::optional<std::size_t> hung;
-  while (!pipeline.finished()) {
-    const auto now = std::chrono::steady_clock::now();
-    const std::optional<std::size_t> stuck = pipeline.stuck_stage(stage_timeout);
-    if (stuck && !hung) {
-      spdlog::error("the {} stage has been busy with one frame for more than {} s: it hangs{}",
-                    pipeline::Pipeline::kThreads[*stuck], stage_timeout_s,
-                    notifier.watchdog_enabled() ? "; the systemd watchdog is no longer petted" : "");
-      notifier.status(std::string("hung in the ") + std::string(pipeline::Pipeline::kThreads[*stuck]) +
-                      " stage");
-    } else if (!stuck && hung) {
-      spdlog::warn("the {} stage moves again", pipeline::Pipeline::kThreads[*hung]);
-    }
-    hung = stuck;
-    if (!hung && notifier.watchdog_enabled() && now - last_pet >= pet_every) {
-      notifier.watchdog();
-      last_pet = now;
-    }
-    if (!hung && now - last_status >= std::chrono::seconds(1)) {
-      notifier.status("running: frames in " + std::to_string(pipeline.frames_captured()) + ", out " +
-                      std::to_string(pipeline.frames_out()) + ", dropped " +
-                      std::to_string(pipeline.frames_dropped()) + ", skipped " +
-                      std::to_string(counts.skipped.load(std::memory_order_relaxed)) + ", without odometry " +
-                      std::to_string(counts.without_odometry.load(std::memory_order_relaxed)) + "; map " +
-                      std::to_string(counts.map_points.load(std::memory_order_relaxed)) + " points");
-      last_status = now;
-    }
-    const int signal = sigtimedwait(&signals, nullptr, &tick);
-    if (signal > 0) {
-      spdlog::info("signal {}: draining the pipeline", signal);
-      return true;
-    }
-  }
-  return false;
 }
 
 int run_service(const std::string &config_file) {

@@ -1,0 +1,37 @@
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+#include <stdexcept>
+
+#include "omnislam/io/config.hpp"
+#include "omnislam/io/snapshot.hpp"
+#include "omnislam/pipeline/frame.hpp"
+
+// omnislamd's saved state: where the snapshot lives, resuming from it at start, and the
+// snapshot of a frame that went through the pipeline.
+namespace omnislam::app {
+
+/// The saved state cannot be used: a corrupt snapshot under on_corrupt_snapshot: refuse,
+/// or localization-only mode without a map. omnislamd exits with code 3 on it.
+class StateError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+/// persistence.state_dir, else systemd's $STATE_DIRECTORY (its first entry), joined with
+/// state.omnisnap; empty: no persistence.
+[[nodiscard]] std::filesystem::path state_file(const io::PersistenceConfig &persistence);
+
+/// The snapshot to resume from (empty: a new map), per config.persistence; logs what
+/// happened. Throws StateError when the service must not start.
+[[nodiscard]] std::optional<io::Snapshot> resume_state(const io::Config &config,
+                                                       const std::filesystem::path &file,
+                                                       std::uint64_t config_hash);
+
+/// The snapshot of `frame`, which must carry the map (Frame::map, map_integrations).
+[[nodiscard]] io::Snapshot make_snapshot(const pipeline::Frame &frame, const io::SnapshotCounters &counters,
+                                         std::uint64_t config_hash);
+
+}  // namespace omnislam::app
