@@ -15,6 +15,7 @@
 #include "omnislam/io/dataset.hpp"
 #include "omnislam/io/ground_truth_files.hpp"
 #include "omnislam/io/image_file.hpp"
+#include "omnislam/io/poses.hpp"
 #include "omnislam/pipeline/pipeline.hpp"
 
 using namespace omnislam;
@@ -32,12 +33,7 @@ Data load(const std::filesystem::path &dir) {
   const io::DatasetInfo info = io::read_dataset_info(dir);
   data.scan.camera = info.camera;
   data.scan.camera_height_m = info.camera_height_m;
-  for (const io::StampedPose &p : io::read_tum_file(info.odometry)) {
-    Eigen::Isometry2d T = Eigen::Isometry2d::Identity();
-    T.linear() = Eigen::Rotation2Dd(p.yaw_rad()).toRotationMatrix();
-    T.translation() = Eigen::Vector2d(p.x_m, p.y_m);
-    data.odometry.push_back(T);
-  }
+  data.odometry = io::to_isometries(io::read_tum_file(info.odometry));
   for (int i = 1; i <= info.frames; ++i)
     data.images.push_back(io::read_camera_image(info.image(i), data.scan.camera));
   return data;

@@ -20,6 +20,7 @@
 #include "omnislam/io/image_file.hpp"
 #include "omnislam/io/poses.hpp"
 #include "omnislam/slam/evaluation.hpp"
+#include "omnislam/slam/planar_pose.hpp"
 #include "omnislam/slam/trimmed_icp.hpp"
 #include "omnislam/stereo/scan_reconstructor.hpp"
 
@@ -51,10 +52,7 @@ Eigen::Isometry2d pcl_icp(const Points2 &model, const Points2 &sample, const Eig
   pcl::PointCloud<pcl::PointXYZ> aligned;
   icp.align(aligned, initial);
   const Eigen::Matrix4f T = icp.getFinalTransformation();
-  Eigen::Isometry2d out = Eigen::Isometry2d::Identity();
-  out.linear() = Eigen::Rotation2Dd(std::atan2(T(1, 0), T(0, 0))).toRotationMatrix();
-  out.translation() = T.topRightCorner<2, 1>().cast<double>();
-  return out;
+  return omnislam::slam::planar_pose(T(0, 3), T(1, 3), std::atan2(T(1, 0), T(0, 0)));
 }
 
 Registration trimmed_icp(omnislam::slam::IcpMetric metric) {

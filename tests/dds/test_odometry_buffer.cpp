@@ -3,16 +3,11 @@
 #include <numbers>
 
 #include "omnislam/dds/odometry_buffer.hpp"
+#include "omnislam/slam/planar_pose.hpp"
 
 // rt/odom samples matched to frame times, and the gaps of the stream (no DDS needed).
 using omnislam::dds::OdometryBuffer;
 using omnislam::dds::OdometryLookup;
-
-namespace {
-
-double yaw_of(const Eigen::Isometry2d &T) { return std::atan2(T.linear()(1, 0), T.linear()(0, 0)); }
-
-}  // namespace
 
 TEST_CASE("odometry buffer: interpolates between samples, also across +-pi", "[dds][odometry]") {
   OdometryBuffer buffer;
@@ -21,7 +16,8 @@ TEST_CASE("odometry buffer: interpolates between samples, also across +-pi", "[d
   const auto mid = buffer.at(10.05);
   REQUIRE(mid);
   CHECK(mid->translation().isApprox(Eigen::Vector2d(1.5, 3.0), 1e-9));
-  CHECK(std::abs(std::remainder(yaw_of(*mid) - std::numbers::pi, 2.0 * std::numbers::pi)) < 1e-9);
+  CHECK(std::abs(std::remainder(omnislam::slam::yaw_rad_of(*mid) - std::numbers::pi,
+                                2.0 * std::numbers::pi)) < 1e-9);
   CHECK(buffer.at(10.0)->translation().isApprox(Eigen::Vector2d(1.0, 2.0)));
 }
 

@@ -8,6 +8,7 @@
 #include <zlib.h>
 
 #include "omnislam/io/snapshot.hpp"
+#include "omnislam/slam/planar_pose.hpp"
 
 namespace fs = std::filesystem;
 using omnislam::io::Snapshot;
@@ -99,8 +100,7 @@ TEST_CASE("snapshot: written atomically and read back exactly", "[io][snapshot]"
   CHECK(read.t_s == 12.5);
   CHECK(read.T_map_base.translation().x() == 1.25);
   CHECK(read.T_map_base.translation().y() == -0.5);
-  CHECK(std::atan2(read.T_map_base.linear()(1, 0), read.T_map_base.linear()(0, 0)) ==
-        Approx(0.75).epsilon(1e-15));
+  CHECK(omnislam::slam::yaw_rad_of(read.T_map_base) == Approx(0.75).epsilon(1e-15));
   CHECK(read.covariance == written.covariance);
   CHECK(read.counters.frames == 125);
   CHECK(read.counters.integrated == 120);

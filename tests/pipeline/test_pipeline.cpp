@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "omnislam/pipeline/pipeline.hpp"
+#include "omnislam/slam/planar_pose.hpp"
 
 // The pipeline's threading on synthetic frames: every image is unusable (empty), so the
 // stages only pass frames on and SLAM propagates the odometry; what is checked is order,
@@ -17,10 +18,8 @@ using namespace std::chrono_literals;
 namespace {
 
 Eigen::Isometry2d odometry_at(std::uint64_t index) {
-  Eigen::Isometry2d T = Eigen::Isometry2d::Identity();
-  T.translation() = Eigen::Vector2d(0.01 * static_cast<double>(index), 0.0);
-  T.linear() = Eigen::Rotation2Dd(0.001 * static_cast<double>(index)).toRotationMatrix();
-  return T;
+  return omnislam::slam::planar_pose(0.01 * static_cast<double>(index), 0.0,
+                                     0.001 * static_cast<double>(index));
 }
 
 FrameSource synthetic_source(std::uint64_t frames, std::chrono::microseconds period = 0us) {

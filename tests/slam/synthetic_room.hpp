@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "omnislam/slam/nearest_neighbors.hpp"
+#include "omnislam/slam/planar_pose.hpp"
 
 // A synthetic world for SLAM tests: wall segments, scans by ray casting one beam per degree
 // with range noise, and the thesis odometry noise model.
@@ -66,7 +67,7 @@ inline std::optional<double> cast(const std::vector<Segment> &walls, const Eigen
 inline slam::Points2 scan_from(const std::vector<Segment> &walls, const Eigen::Isometry2d &T_map_base,
                                std::mt19937_64 &rng, double noise_m = 0.01, double max_range_m = 3.0) {
   std::normal_distribution<double> noise(0.0, noise_m);
-  const double yaw = std::atan2(T_map_base.linear()(1, 0), T_map_base.linear()(0, 0));
+  const double yaw = slam::yaw_rad_of(T_map_base);
   slam::Points2 scan;
   for (int deg = 0; deg < 360; ++deg) {
     const double azimuth = (deg + 0.5) * std::numbers::pi / 180.0;
@@ -78,11 +79,6 @@ inline slam::Points2 scan_from(const std::vector<Segment> &walls, const Eigen::I
   return scan;
 }
 
-inline Eigen::Isometry2d pose(double x, double y, double yaw) {
-  Eigen::Isometry2d T = Eigen::Isometry2d::Identity();
-  T.linear() = Eigen::Rotation2Dd(yaw).toRotationMatrix();
-  T.translation() = Eigen::Vector2d(x, y);
-  return T;
-}
+inline Eigen::Isometry2d pose(double x, double y, double yaw) { return slam::planar_pose(x, y, yaw); }
 
 }  // namespace omnislam::test

@@ -8,13 +8,8 @@
 using omnislam::slam::NearestNeighbors;
 using omnislam::slam::Points2;
 using omnislam::slam::register_trimmed_icp;
+using omnislam::slam::yaw_rad_of;
 using omnislam::test::pose;
-
-namespace {
-
-double yaw_of(const Eigen::Isometry2d &T) { return std::atan2(T.linear()(1, 0), T.linear()(0, 0)); }
-
-}  // namespace
 
 TEST_CASE("trimmed ICP recovers a known motion between two scans of a room", "[slam][icp]") {
   const auto walls = omnislam::test::l_room();
@@ -33,7 +28,7 @@ TEST_CASE("trimmed ICP recovers a known motion between two scans of a room", "[s
   REQUIRE(result.valid);
   const Eigen::Isometry2d error = truth.inverse() * result.T_model_sample;
   CHECK(error.translation().norm() < 0.01);
-  CHECK(std::abs(yaw_of(error)) < 0.2 * std::numbers::pi / 180.0);
+  CHECK(std::abs(yaw_rad_of(error)) < 0.2 * std::numbers::pi / 180.0);
   CHECK(std::sqrt(result.final_error_m2) < 0.02);
   CHECK(result.srel_percent > 50.0);
   CHECK(result.inlier_share > 0.8);
@@ -60,7 +55,7 @@ TEST_CASE("trimmed ICP: trimming ignores points the model does not contain", "[s
   REQUIRE(result.valid);
   const Eigen::Isometry2d error = truth.inverse() * result.T_model_sample;
   CHECK(error.translation().norm() < 0.005);
-  CHECK(std::abs(yaw_of(error)) < 0.002);
+  CHECK(std::abs(yaw_rad_of(error)) < 0.002);
 }
 
 TEST_CASE("trimmed ICP: thesis scale mode estimates a scale factor", "[slam][icp]") {

@@ -1,4 +1,5 @@
 #include "map_command.hpp"
+#include "omnislam/slam/planar_pose.hpp"
 
 #include <cinttypes>
 #include <cstdio>
@@ -18,8 +19,7 @@ namespace {
 
 void print_info(const std::filesystem::path &file) {
   const io::Snapshot s = io::read_snapshot(file);
-  const double yaw_deg =
-      std::atan2(s.T_map_base.linear()(1, 0), s.T_map_base.linear()(0, 0)) * 180.0 / std::numbers::pi;
+  const double yaw_deg = slam::yaw_rad_of(s.T_map_base) * 180.0 / std::numbers::pi;
   const io::SnapshotCounters &n = s.counters;
   std::printf("snapshot: %s\n", file.c_str());
   std::printf("version: %u\n", s.version);
@@ -30,10 +30,9 @@ void print_info(const std::filesystem::path &file) {
   std::printf("pose sigma: x %.4f m, y %.4f m, yaw %.3f deg\n", std::sqrt(s.covariance(0, 0)),
               std::sqrt(s.covariance(1, 1)), std::sqrt(s.covariance(2, 2)) * 180.0 / std::numbers::pi);
   if (s.T_odom_base) {
-    std::printf(
-        "odometry: x %.4f m, y %.4f m, yaw %.3f deg\n", s.T_odom_base->translation().x(),
-        s.T_odom_base->translation().y(),
-        std::atan2(s.T_odom_base->linear()(1, 0), s.T_odom_base->linear()(0, 0)) * 180.0 / std::numbers::pi);
+    std::printf("odometry: x %.4f m, y %.4f m, yaw %.3f deg\n", s.T_odom_base->translation().x(),
+                s.T_odom_base->translation().y(),
+                slam::yaw_rad_of(*s.T_odom_base) * 180.0 / std::numbers::pi);
   } else {
     std::printf("odometry: none\n");
   }

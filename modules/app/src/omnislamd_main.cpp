@@ -154,8 +154,9 @@ int run_service(const std::string &config_file) {
       if (frame.map) publisher->map(frame.stamp_s, *frame.map);
     }
     if (frame.map) counts.map_points.store(frame.map->size(), std::memory_order_relaxed);
-    if (frame.state_due && snapshots) snapshots->submit(make_snapshot(frame, n, config_hash));
     last_frame = frame_record(frame);
+    if (frame.state_due && snapshots)
+      snapshots->submit(make_snapshot(*last_frame, *frame.map, frame.map_integrations, n, config_hash));
     if (!service.output_dir.empty()) run.frames.push_back(*last_frame);
   };
   sinks.profile = [&](const pipeline::ProfileSnapshot &profile) {
@@ -198,15 +199,8 @@ int run_service(const std::string &config_file) {
   const double last_stamp = last_frame ? last_frame->t_s : status.stamp_s;
   if (snapshots && last_frame) {
     // The final state, written before anything else can fail.
-    pipeline::Frame last;
-    last.stamp_s = last_frame->t_s;
-    last.estimate.T_map_base = last_frame->T_map_base;
-    last.estimate.covariance = last_frame->covariance;
-    last.T_odom_base = last_frame->T_odom_base;
-    last.has_odometry = last_frame->has_odometry;
-    last.map_integrations = pipeline.slam().map().integrations();
-    last.map = std::make_shared<const std::vector<slam::MapPoint>>(pipeline.slam().map().points());
-    snapshots->submit(make_snapshot(last, counts.totals, config_hash));
+    snapshots->submit(make_snapshot(*last_frame, pipeline.slam().map().points(),
+                                    pipeline.slam().map().integrations(), counts.totals, config_hash));
   }
   if (snapshots) {
     snapshots->finish();

@@ -1,4 +1,5 @@
 #include "run_outputs.hpp"
+#include "omnislam/slam/planar_pose.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -18,8 +19,6 @@ namespace {
 
 constexpr double kMmPerM = 1000.0;
 constexpr double kDegPerRad = 180.0 / std::numbers::pi;
-
-double yaw_of(const Eigen::Isometry2d &T) { return std::atan2(T.linear()(1, 0), T.linear()(0, 0)); }
 
 nlohmann::json stage_statistics(const std::vector<FrameRecord> &frames) {
   nlohmann::json stages = nlohmann::json::object();
@@ -46,7 +45,7 @@ std::string thesis_localisation(const RunRecord &run) {
   for (const FrameRecord &f : run.frames) {
     if (f.integrated) {
       std::snprintf(line, sizeof line, "%.3f %.3f %.4f\n", f.T_map_base.translation().x() * kMmPerM,
-                    f.T_map_base.translation().y() * kMmPerM, yaw_of(f.T_map_base) * kDegPerRad);
+                    f.T_map_base.translation().y() * kMmPerM, slam::yaw_rad_of(f.T_map_base) * kDegPerRad);
     } else {
       std::snprintf(line, sizeof line, "0 0 0\n");
     }

@@ -53,17 +53,17 @@ std::optional<io::Snapshot> resume_state(const io::Config &config, const std::fi
   return snapshot;
 }
 
-io::Snapshot make_snapshot(const pipeline::Frame &frame, const io::SnapshotCounters &counters,
-                           std::uint64_t config_hash) {
+io::Snapshot make_snapshot(const FrameRecord &frame, std::vector<slam::MapPoint> points, int map_integrations,
+                           const io::SnapshotCounters &counters, std::uint64_t config_hash) {
   io::Snapshot s;
   s.config_hash = config_hash;
-  s.t_s = frame.stamp_s;
-  s.T_map_base = frame.estimate.T_map_base;
-  s.covariance = frame.estimate.covariance;
+  s.t_s = frame.t_s;
+  s.T_map_base = frame.T_map_base;
+  s.covariance = frame.covariance;
   if (frame.has_odometry) s.T_odom_base = frame.T_odom_base;
   s.counters = counters;
-  s.map_integrations = frame.map_integrations;
-  s.points = *frame.map;
+  s.map_integrations = map_integrations;
+  s.points = std::move(points);
   return s;
 }
 

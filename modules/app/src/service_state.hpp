@@ -4,13 +4,15 @@
 #include <filesystem>
 #include <optional>
 #include <stdexcept>
+#include <vector>
 
 #include "omnislam/io/config.hpp"
 #include "omnislam/io/snapshot.hpp"
-#include "omnislam/pipeline/frame.hpp"
+#include "omnislam/slam/point_map.hpp"
+#include "run_record.hpp"
 
 // omnislamd's saved state: where the snapshot lives, resuming from it at start, and the
-// snapshot of a frame that went through the pipeline.
+// snapshot after a frame that went through the pipeline.
 namespace omnislam::app {
 
 /// The saved state cannot be used: a corrupt snapshot under on_corrupt_snapshot: refuse,
@@ -30,8 +32,10 @@ class StateError : public std::runtime_error {
                                                        const std::filesystem::path &file,
                                                        std::uint64_t config_hash);
 
-/// The snapshot of `frame`, which must carry the map (Frame::map, map_integrations).
-[[nodiscard]] io::Snapshot make_snapshot(const pipeline::Frame &frame, const io::SnapshotCounters &counters,
+/// The snapshot after `frame`: its pose, covariance and odometry, with the map as it was
+/// then (points and slam::PointMap::integrations()).
+[[nodiscard]] io::Snapshot make_snapshot(const FrameRecord &frame, std::vector<slam::MapPoint> points,
+                                         int map_integrations, const io::SnapshotCounters &counters,
                                          std::uint64_t config_hash);
 
 }  // namespace omnislam::app

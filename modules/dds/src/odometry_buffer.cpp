@@ -1,21 +1,11 @@
 #include "omnislam/dds/odometry_buffer.hpp"
+#include "omnislam/slam/planar_pose.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <numbers>
 
 namespace omnislam::dds {
-namespace {
-
-Eigen::Isometry2d planar(double x_m, double y_m, double yaw_rad) {
-  Eigen::Isometry2d T = Eigen::Isometry2d::Identity();
-  T.translation() = Eigen::Vector2d(x_m, y_m);
-  T.linear() = Eigen::Rotation2Dd(yaw_rad).toRotationMatrix();
-  return T;
-}
-
-}  // namespace
-
 void OdometryBuffer::insert(const Sample &sample) {
   const auto at = std::lower_bound(samples_.begin(), samples_.end(), sample.stamp_s,
                                    [](const Sample &s, double t) { return s.stamp_s < t; });
@@ -34,20 +24,20 @@ std::optional<Eigen::Isometry2d> OdometryBuffer::at(double stamp_s, const Odomet
   if (after == samples_.end()) {
     const Sample &last = samples_.back();
     if (stamp_s - last.stamp_s > lookup.max_extrapolation_s) return std::nullopt;
-    return planar(last.x_m, last.y_m, last.yaw_rad);
+    return slam::planar_pose(last.x_m, last.y_m, last.yaw_rad);
   }
-  if (after->stamp_s == stamp_s) return planar(after->x_m, after->y_m, after->yaw_rad);
+  if (after->stamp_s == stamp_s) return slam::planar_pose(after->x_m, after->y_m, after->yaw_rad);
   const Sample &a = *(after - 1);  // after != begin: stamp_s >= the first stamp
   const Sample &b = *after;
   if (b.stamp_s - a.stamp_s > lookup.max_interpolation_gap_s) {
     // A gap: only a frame close after its start gets the sample before it (as live frames
     // get the newest sample).
     if (stamp_s - a.stamp_s > lookup.max_extrapolation_s) return std::nullopt;
-    return planar(a.x_m, a.y_m, a.yaw_rad);
+    return slam::planar_pose(a.x_m, a.y_m, a.yaw_rad);
   }
   const double w = (stamp_s - a.stamp_s) / (b.stamp_s - a.stamp_s);
   const double dyaw = std::remainder(b.yaw_rad - a.yaw_rad, 2.0 * std::numbers::pi);
-  return planar(a.x_m + w * (b.x_m - a.x_m), a.y_m + w * (b.y_m - a.y_m), a.yaw_rad + w * dyaw);
+  return slam::planar_pose(a.x_m + w * (b.x_m - a.x_m), a.y_m + w * (b.y_m - a.y_m), a.yaw_rad + w * dyaw);
 }
 
 }  // namespace omnislam::dds

@@ -1,4 +1,5 @@
 #include "omnislam/dds/publisher.hpp"
+#include "omnislam/slam/planar_pose.hpp"
 
 #include <array>
 #include <chrono>
@@ -51,7 +52,7 @@ Publisher::Publisher(const Participant &participant) {
 void Publisher::pose(double stamp_s, const Eigen::Isometry2d &T_map_base, const Eigen::Matrix3d &covariance) {
   geometry_msgs_msg_dds__PoseWithCovarianceStamped_ msg{};
   msg.header = header(stamp_s, "map");
-  const double yaw = std::atan2(T_map_base.linear()(1, 0), T_map_base.linear()(0, 0));
+  const double yaw = slam::yaw_rad_of(T_map_base);
   msg.pose.pose.position = {T_map_base.translation().x(), T_map_base.translation().y(), 0.0};
   msg.pose.pose.orientation = {0.0, 0.0, std::sin(yaw / 2.0), std::cos(yaw / 2.0)};
   // (x, y, yaw) -> rows/columns (0, 1, 5) of ROS's (x, y, z, roll, pitch, yaw).

@@ -1,4 +1,5 @@
 #include "omnislam/io/snapshot.hpp"
+#include "omnislam/slam/planar_pose.hpp"
 
 #include <fcntl.h>
 #include <unistd.h>
@@ -109,7 +110,7 @@ std::vector<std::uint8_t> encode_snapshot(const Snapshot &snapshot) {
   const Eigen::Vector2d t = snapshot.T_map_base.translation();
   payload.f64(t.x());
   payload.f64(t.y());
-  payload.f64(std::atan2(snapshot.T_map_base.linear()(1, 0), snapshot.T_map_base.linear()(0, 0)));
+  payload.f64(slam::yaw_rad_of(snapshot.T_map_base));
   for (int r = 0; r < 3; ++r)
     for (int c = 0; c < 3; ++c) payload.f64(snapshot.covariance(r, c));
   const SnapshotCounters &n = snapshot.counters;
@@ -120,7 +121,7 @@ std::vector<std::uint8_t> encode_snapshot(const Snapshot &snapshot) {
   payload.u64(snapshot.T_odom_base ? 1 : 0);
   payload.f64(odom.translation().x());
   payload.f64(odom.translation().y());
-  payload.f64(std::atan2(odom.linear()(1, 0), odom.linear()(0, 0)));
+  payload.f64(slam::yaw_rad_of(odom));
   payload.u64(snapshot.points.size());
   for (const slam::MapPoint &p : snapshot.points) {
     payload.f64(p.position_m.x());
@@ -173,7 +174,7 @@ Snapshot decode_snapshot(std::span<const std::uint8_t> bytes, const std::string 
   s.config_hash = in.u64();
   s.t_s = in.f64("t_s");
   const double x = in.f64("x_m"), y = in.f64("y_m"), yaw = in.f64("yaw_rad");
-  s.T_map_base = Eigen::Translation2d(x, y) * Eigen::Rotation2Dd(yaw);
+  s.T_map_base = slam::planar_pose(x, y, yaw);
   for (int r = 0; r < 3; ++r)
     for (int c = 0; c < 3; ++c) s.covariance(r, c) = in.f64("covariance");
   SnapshotCounters &n = s.counters;
@@ -188,7 +189,7 @@ Snapshot decode_snapshot(std::span<const std::uint8_t> bytes, const std::string 
     const std::uint64_t has_odometry = in.u64();
     if (has_odometry > 1) throw SnapshotError(name + ": has_odometry is " + std::to_string(has_odometry));
     const double ox = in.f64("odom x_m"), oy = in.f64("odom y_m"), oyaw = in.f64("odom yaw_rad");
-    if (has_odometry == 1) s.T_odom_base = Eigen::Translation2d(ox, oy) * Eigen::Rotation2Dd(oyaw);
+    if (has_odometry == 1) s.T_odom_base = slam::planar_pose(ox, oy, oyaw);
   }
   const std::uint64_t count = in.u64();
   const std::uint64_t point_bytes = payload.size() - fixed_bytes;

@@ -1,4 +1,5 @@
 #include "omnislam/slam/odometry_noise.hpp"
+#include "omnislam/slam/planar_pose.hpp"
 
 #include <cmath>
 #include <numbers>
@@ -15,7 +16,7 @@ std::vector<Eigen::Isometry2d> apply_thesis_odometry_noise(const std::vector<Eig
   noisy.push_back(exact.front());
   for (std::size_t i = 1; i < exact.size(); ++i) {
     const Eigen::Isometry2d step = exact[i - 1].inverse() * exact[i];
-    const double step_yaw = std::atan2(step.linear()(1, 0), step.linear()(0, 0));
+    const double step_yaw = yaw_rad_of(step);
     const double length_scale = 1.0 + 0.10 * unit(rng);
     const double relative = 0.10 * unit(rng) * step_yaw;
     const double absolute = 1.5 * std::numbers::pi / 180.0 * unit(rng);

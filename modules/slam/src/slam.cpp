@@ -1,4 +1,5 @@
 #include "omnislam/slam/slam.hpp"
+#include "omnislam/slam/planar_pose.hpp"
 
 #include <cmath>
 #include <numbers>
@@ -14,15 +15,13 @@ Points2 transformed(const Points2 &points, const Eigen::Isometry2d &T) {
   return out;
 }
 
-double yaw_of(const Eigen::Isometry2d &T) { return std::atan2(T.linear()(1, 0), T.linear()(0, 0)); }
-
 // Odometry uncertainty of one step, used to grow the covariance of unregistered frames
 // (the thesis noise model: 10% of the distance, 1.5 deg of heading).
 Eigen::Matrix3d odometry_step_covariance(const Eigen::Isometry2d &step) {
   const double distance = step.translation().norm();
   const double sigma_xy = 0.1 * distance / std::sqrt(3.0);
   const double sigma_yaw =
-      std::max(0.1 * std::abs(yaw_of(step)), 1.5 * std::numbers::pi / 180.0) / std::sqrt(3.0);
+      std::max(0.1 * std::abs(yaw_rad_of(step)), 1.5 * std::numbers::pi / 180.0) / std::sqrt(3.0);
   return Eigen::Vector3d(sigma_xy * sigma_xy, sigma_xy * sigma_xy, sigma_yaw * sigma_yaw).asDiagonal();
 }
 
@@ -36,7 +35,7 @@ bool Slam::accept(const TrimmedIcpResult &registration, const Eigen::Isometry2d 
   if (registration.inlier_share < config_.min_inlier_share) return false;
   const Eigen::Isometry2d correction = predicted.inverse() * estimate;
   return correction.translation().norm() <= config_.max_correction_m &&
-         std::abs(yaw_of(correction)) <= config_.max_correction_rad;
+         std::abs(yaw_rad_of(correction)) <= config_.max_correction_rad;
 }
 
 bool Slam::accept_without_odometry(const TrimmedIcpResult &registration, const Eigen::Isometry2d &predicted,
@@ -46,7 +45,7 @@ bool Slam::accept_without_odometry(const TrimmedIcpResult &registration, const E
   if (registration.inlier_share < config_.min_inlier_share) return false;
   const Eigen::Isometry2d correction = predicted.inverse() * estimate;
   return correction.translation().norm() <= config_.icp.initial_search_radius_m &&
-         std::abs(yaw_of(correction)) <= config_.no_odometry_max_rotation_rad;
+         std::abs(yaw_rad_of(correction)) <= config_.no_odometry_max_rotation_rad;
 }
 
 FrameEstimate Slam::register_scan(const Points2 &scan_base, const Eigen::Isometry2d &predicted) {

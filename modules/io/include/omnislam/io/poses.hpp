@@ -5,16 +5,14 @@
 #include <vector>
 
 #include "omnislam/io/ground_truth_files.hpp"
+#include "omnislam/slam/planar_pose.hpp"
 
 /// @file
 /// Conversions between TUM records and planar poses (yaw about z, z = 0 at floor level).
 namespace omnislam::io {
 
 inline Eigen::Isometry2d to_isometry(const StampedPose &pose) {
-  Eigen::Isometry2d T = Eigen::Isometry2d::Identity();
-  T.linear() = Eigen::Rotation2Dd(pose.yaw_rad()).toRotationMatrix();
-  T.translation() = Eigen::Vector2d(pose.x_m, pose.y_m);
-  return T;
+  return slam::planar_pose(pose.x_m, pose.y_m, pose.yaw_rad());
 }
 
 inline std::vector<Eigen::Isometry2d> to_isometries(const std::vector<StampedPose> &poses) {
@@ -25,7 +23,7 @@ inline std::vector<Eigen::Isometry2d> to_isometries(const std::vector<StampedPos
 }
 
 inline StampedPose to_stamped(double t_s, const Eigen::Isometry2d &T) {
-  const double yaw = std::atan2(T.linear()(1, 0), T.linear()(0, 0));
+  const double yaw = slam::yaw_rad_of(T);
   StampedPose pose;
   pose.t_s = t_s;
   pose.x_m = T.translation().x();

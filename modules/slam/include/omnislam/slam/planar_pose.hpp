@@ -1,0 +1,24 @@
+#pragma once
+
+#include <Eigen/Geometry>
+#include <cmath>
+
+/// @file
+/// Planar poses (x, y, yaw about z) as Eigen::Isometry2d.
+
+namespace omnislam::slam {
+
+/// The rotation angle of `T`, in (-pi, pi].
+[[nodiscard]] inline double yaw_rad_of(const Eigen::Isometry2d &T) {
+  return std::atan2(T.linear()(1, 0), T.linear()(0, 0));
+}
+
+/// The pose at (x_m, y_m) turned by yaw_rad.
+[[nodiscard]] inline Eigen::Isometry2d planar_pose(double x_m, double y_m, double yaw_rad) {
+  Eigen::Isometry2d T = Eigen::Isometry2d::Identity();
+  T.linear() = Eigen::Rotation2Dd(yaw_rad).toRotationMatrix();
+  T.translation() = Eigen::Vector2d(x_m, y_m);
+  return T;
+}
+
+}  // namespace omnislam::slam
