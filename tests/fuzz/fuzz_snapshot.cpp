@@ -1,5 +1,3 @@
-#include <zlib.h>
-
 #include <cstddef>
 #include <cstdint>
 #include <cstdlib>
@@ -7,6 +5,7 @@
 #include <vector>
 
 #include "omnislam/io/snapshot.hpp"
+#include "snapshot_bytes.hpp"
 
 // decode_snapshot on arbitrary bytes: a snapshot or a SnapshotError. A random header almost
 // never has the right magic, size and CRC, so for inputs starting with an even byte the
@@ -16,14 +15,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t *data, std::size_t size
   std::vector<std::uint8_t> bytes(data, data + size);
   if (size >= 24 && data[0] % 2 == 0) {
     std::memcpy(bytes.data(), "OMNISNAP", 8);
-    const std::uint64_t payload = size - 24;
-    for (int i = 0; i < 8; ++i)
-      bytes[12 + static_cast<std::size_t>(i)] = static_cast<std::uint8_t>(payload >> (8 * i));
-    uLong crc = crc32(0L, Z_NULL, 0);
-    crc = crc32(crc, bytes.data() + 8, 12);
-    crc = crc32(crc, bytes.data() + 24, static_cast<uInt>(payload));
-    for (int i = 0; i < 4; ++i)
-      bytes[20 + static_cast<std::size_t>(i)] = static_cast<std::uint8_t>(crc >> (8 * i));
+    omnislam::test::reseal_snapshot(bytes);
   }
   try {
     const omnislam::io::Snapshot snapshot = omnislam::io::decode_snapshot(bytes, "fuzz.snap");

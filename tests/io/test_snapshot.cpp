@@ -5,10 +5,9 @@
 #include <iterator>
 #include <vector>
 
-#include <zlib.h>
-
 #include "omnislam/io/snapshot.hpp"
 #include "omnislam/slam/planar_pose.hpp"
+#include "snapshot_bytes.hpp"
 
 namespace fs = std::filesystem;
 using omnislam::io::Snapshot;
@@ -46,18 +45,6 @@ void write_bytes(const fs::path &file, const std::vector<std::uint8_t> &bytes) {
       .write(reinterpret_cast<const char *>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
 }
 
-// Recomputes the header's payload size and CRC after a test edited the bytes.
-void reseal(std::vector<std::uint8_t> &bytes) {
-  const std::uint64_t payload = bytes.size() - 24;
-  for (int i = 0; i < 8; ++i)
-    bytes[12 + static_cast<std::size_t>(i)] = static_cast<std::uint8_t>(payload >> (8 * i));
-  uLong crc = crc32(0L, Z_NULL, 0);
-  crc = crc32(crc, bytes.data() + 8, 12);
-  crc = crc32(crc, bytes.data() + 24, static_cast<uInt>(payload));
-  for (int i = 0; i < 4; ++i)
-    bytes[20 + static_cast<std::size_t>(i)] = static_cast<std::uint8_t>(crc >> (8 * i));
-}
-
 }  // namespace
 
 TEST_CASE("snapshot: the odometry pose round-trips; version-1 files (without it) are still read",
@@ -78,7 +65,7 @@ TEST_CASE("snapshot: the odometry pose round-trips; version-1 files (without it)
   v1.erase(v1.begin() + static_cast<std::ptrdiff_t>(odometry_at),
            v1.begin() + static_cast<std::ptrdiff_t>(odometry_at + 32));
   v1[8] = 1;
-  reseal(v1);
+  omnislam::test::reseal_snapshot(v1);
   read = omnislam::io::decode_snapshot(v1, "v1.snap");
   CHECK_FALSE(read.T_odom_base);
   CHECK(read.points.size() == 50);
@@ -168,7 +155,7 @@ TEST_CASE("snapshot: a future version or impossible values are named even with a
   // A version-3 file (as a newer build would write it) has a valid CRC of its own.
   std::vector<std::uint8_t> v3 = omnislam::io::encode_snapshot(example());
   v3[8] = 3;
-  reseal(v3);
+  omnislam::test::reseal_snapshot(v3);
   CHECK_THROWS_WITH(
       omnislam::io::decode_snapshot(v3, "v3.snap"),
       Catch::Equals("v3.snap: unsupported snapshot version 3 (this build reads versions 1 to 2)"));

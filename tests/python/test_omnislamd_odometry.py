@@ -8,9 +8,9 @@ domain id of its own. Run by ctest ("dds: omnislamd with rt/odom gaps")."""
 import os
 import shutil
 import subprocess
+import sys
 import threading
 import time
-from dataclasses import dataclass
 from pathlib import Path
 
 import pytest
@@ -21,89 +21,13 @@ pytestmark = pytest.mark.skipif(not os.environ.get("OMNISLAMD_BIN"), reason="nee
 os.environ.setdefault("CYCLONEDDS_URI", (REPO / "deploy" / "cyclonedds.xml").as_uri())
 from cyclonedds.core import Policy, Qos  # noqa: E402  (after CYCLONEDDS_URI)
 from cyclonedds.domain import DomainParticipant  # noqa: E402
-from cyclonedds.idl import IdlStruct  # noqa: E402
-from cyclonedds.idl import annotations as annotate  # noqa: E402
-from cyclonedds.idl import types  # noqa: E402
 from cyclonedds.pub import DataWriter  # noqa: E402
 from cyclonedds.topic import Topic  # noqa: E402
 from cyclonedds.util import duration  # noqa: E402
 
-
-# The ROS 2 layouts of interfaces/ros2.idl (see scripts/omnislam-subscribe).
-@dataclass
-@annotate.final
-class Time_(IdlStruct, typename="builtin_interfaces::msg::dds_::Time_"):
-    sec: types.int32
-    nanosec: types.uint32
-
-
-@dataclass
-@annotate.final
-class Header_(IdlStruct, typename="std_msgs::msg::dds_::Header_"):
-    stamp: Time_
-    frame_id: str
-
-
-@dataclass
-@annotate.final
-class Vector3_(IdlStruct, typename="geometry_msgs::msg::dds_::Vector3_"):
-    x: types.float64
-    y: types.float64
-    z: types.float64
-
-
-@dataclass
-@annotate.final
-class Point_(IdlStruct, typename="geometry_msgs::msg::dds_::Point_"):
-    x: types.float64
-    y: types.float64
-    z: types.float64
-
-
-@dataclass
-@annotate.final
-class Quaternion_(IdlStruct, typename="geometry_msgs::msg::dds_::Quaternion_"):
-    x: types.float64
-    y: types.float64
-    z: types.float64
-    w: types.float64
-
-
-@dataclass
-@annotate.final
-class Pose_(IdlStruct, typename="geometry_msgs::msg::dds_::Pose_"):
-    position: Point_
-    orientation: Quaternion_
-
-
-@dataclass
-@annotate.final
-class PoseWithCovariance_(IdlStruct, typename="geometry_msgs::msg::dds_::PoseWithCovariance_"):
-    pose: Pose_
-    covariance: types.array[types.float64, 36]
-
-
-@dataclass
-@annotate.final
-class Twist_(IdlStruct, typename="geometry_msgs::msg::dds_::Twist_"):
-    linear: Vector3_
-    angular: Vector3_
-
-
-@dataclass
-@annotate.final
-class TwistWithCovariance_(IdlStruct, typename="geometry_msgs::msg::dds_::TwistWithCovariance_"):
-    twist: Twist_
-    covariance: types.array[types.float64, 36]
-
-
-@dataclass
-@annotate.final
-class Odometry_(IdlStruct, typename="nav_msgs::msg::dds_::Odometry_"):
-    header: Header_
-    child_frame_id: str
-    pose: PoseWithCovariance_
-    twist: TwistWithCovariance_
+sys.path.insert(0, str(REPO / "scripts"))
+from omnislam_msgs import (Header_, Odometry_, Point_, Pose_, PoseWithCovariance_, Quaternion_, Time_,  # noqa: E402
+                           Twist_, TwistWithCovariance_, Vector3_)
 
 
 def odometry(stamp: float, x: float) -> Odometry_:
