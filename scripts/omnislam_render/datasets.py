@@ -18,6 +18,7 @@ from . import odometry as odo
 from . import pov
 from .geometry import Pose, compose, inverse, relative_to_first, write_tum, read_tum
 from .rooms import l_room, sim_room
+from .rooms_real import l_room_real, office_real, sim_room_real
 from .scene import Room, frame_scene
 
 TRAJECTORIES_CSV = Path(__file__).resolve().parent / "data" / "trajectories.csv"
@@ -70,6 +71,8 @@ class DatasetSpec:
     world_poses: Callable[[], list[Pose]]   # robot poses in the room frame
     constant_heading: bool
     description: str
+    camera_height_m: float = CAMERA_HEIGHT_M
+    grey: bool = False      # store 8-bit grey PNGs (a third of the size; the front-end reads grey)
 
 
 def _still(points) -> list[Pose]:
@@ -79,6 +82,22 @@ def _still(points) -> list[Pose]:
 def _l_laps(laps: int) -> list[Pose]:
     pts = table_points("3.3")
     return _still(pts * laps + pts[:1])
+
+
+def _rectangle_loop(corners: Sequence[tuple[float, float]], steps: Sequence[int]) -> list[tuple[float, float]]:
+    """Points along a closed polygon, leg i cut into steps[i] equal steps, back to the start."""
+    pts = []
+    for i, n in enumerate(steps):
+        (x0, y0), (x1, y1) = corners[i], corners[(i + 1) % len(corners)]
+        pts += [(round(x0 + (x1 - x0) * k / n, 6), round(y0 + (y1 - y0) * k / n, 6)) for k in range(n)]
+    return pts + [corners[0]]
+
+
+def office_loop() -> list[Pose]:
+    """One lap around the office pillar, counter-clockwise, facing the direction of travel:
+    44 steps of 0.27-0.29 m (12.4 m)."""
+    corners = [(1.2, 1.8), (5.8, 1.8), (5.8, 3.4), (1.2, 3.4)]
+    return facing_travel(_rectangle_loop(corners, [16, 6, 16, 6]))
 
 
 DATASETS: dict[str, DatasetSpec] = {
@@ -93,12 +112,22 @@ DATASETS: dict[str, DatasetSpec] = {
                                "L-shaped room, table 3.3 poses, one lap back to pose 1"),
     "l-room-2laps": DatasetSpec("l-room-2laps", l_room, lambda: _l_laps(2), True,
                                 "L-shaped room, table 3.3 poses, two laps back to pose 1"),
+    # Realistic looks (rooms_real.py): textured floors, skirting, soft shadows, sunlight.
+    "sim-room-37-real": DatasetSpec("sim-room-37-real", sim_room_real, lambda: _still(table_points("3.2")), True,
+                                    "sim-room-37 with ceramic tiles, area lamps and sunlight", grey=True),
+    "l-room-1lap-real": DatasetSpec("l-room-1lap-real", l_room_real, lambda: _l_laps(1), True,
+                                    "l-room-1lap with wood planks, a rug, pendant lamps and sunlight",
+                                    grey=True),
+    "office-real": DatasetSpec("office-real", office_real, office_loop, False,
+                               "office with carpet, pillar loop facing travel, camera 0.8 m up",
+                               camera_height_m=0.8, grey=True),
 }
 
 
-def render_key(room: Room) -> str:
-    text = "|".join([RENDERER_VERSION, room.pov_body(), pov.camera_block(), pov.mirror_block(), ANTIALIAS,
-                     repr(CAMERA_HEIGHT_M)])
+def render_key(room: Room, camera_height_m: float = CAMERA_HEIGHT_M, grey: bool = False) -> str:
+    parts = [RENDERER_VERSION, room.pov_body(), pov.camera_block(), pov.mirror_block(), ANTIALIAS,
+             repr(camera_height_m)]
+    text = "|".join(parts + (["grey"] if grey else []))
     return hashlib.sha256(text.encode()).hexdigest()[:16]
 
 
@@ -115,7 +144,7 @@ def dataset_yaml(spec: DatasetSpec, frames: int, origin: Pose, key: str) -> str:
         f"camera: {{width: {M.IMAGE_PX}, height: {M.IMAGE_PX}, center_px: [{M.CENTER_PX}, {M.CENTER_PX}], "
         f"focal_mm: {M.FOCAL_MM}, pixel_pitch_mm: {_fmt(M.PIXEL_MM)}}}\n"
         "mirror: thesis-2008          # mirror.md, derived constants\n"
-        f"camera_height_m: {CAMERA_HEIGHT_M}         # height of the camera pinhole F0 above the floor\n"
+        f"camera_height_m: {spec.camera_height_m}         # height of the camera pinhole F0 above the floor\n"
         f"frames: {frames}\n"
         f"rate_hz: {RATE_HZ}\n"
         "images: images/%06d.png\n"
@@ -158,7 +187,8 @@ def write_metadata(spec: DatasetSpec, out: Path, frames: int | None = None) -> l
     elif (out / "odometry.txt").exists():
         (out / "odometry.txt").unlink()
     write_floorplan(out / "floorplan.csv", room, origin)
-    (out / "dataset.yaml").write_text(dataset_yaml(spec, len(world), origin, render_key(room)))
+    key = render_key(room, spec.camera_height_m, spec.grey)
+    (out / "dataset.yaml").write_text(dataset_yaml(spec, len(world), origin, key))
     return world
 
 
@@ -206,7 +236,7 @@ def _link_or_copy(src: Path, dst: Path) -> None:
 def render_images(spec: DatasetSpec, out: Path, world: Sequence[Pose], threads: int = 2,
                   log=print) -> dict:
     room = spec.room()
-    key = render_key(room)
+    key = render_key(room, spec.camera_height_m, spec.grey)
     images = out / "images"
     images.mkdir(parents=True, exist_ok=True)
     for stale in images.glob("*.png"):
@@ -226,9 +256,10 @@ def render_images(spec: DatasetSpec, out: Path, world: Sequence[Pose], threads: 
                 reused += 1
             else:
                 pov_file = Path(tmp) / f"{i:06d}.pov"
-                pov_file.write_text(frame_scene(room, pose, CAMERA_HEIGHT_M, camera, mirror))
+                pov_file.write_text(frame_scene(room, pose, spec.camera_height_m, camera, mirror))
                 png_tmp = Path(tmp) / f"{i:06d}.png"
-                times.append(pov.render(pov_file, png_tmp, threads=threads, antialias=ANTIALIAS))
+                times.append(pov.render(pov_file, png_tmp, threads=threads, antialias=ANTIALIAS,
+                                        grey=spec.grey))
                 shutil.move(str(png_tmp), dst)
                 log(f"{spec.name}: frame {i}/{len(world)} rendered in {times[-1]:.2f} s")
             done.setdefault(pk, dst)

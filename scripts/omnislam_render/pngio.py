@@ -131,3 +131,30 @@ def strip_timestamps(path) -> None:
         out.append(chunk)
     with open(path, "wb") as fh:
         fh.write(b"".join(out))
+
+
+def write_png_gray(path, image: np.ndarray) -> None:
+    """Write an 8-bit grey image as a PNG (filter 'Up' on every row, zlib level 9)."""
+    image = np.ascontiguousarray(image, dtype=np.uint8)
+    height, width = image.shape
+    up = np.diff(image.astype(np.int16), axis=0, prepend=0).astype(np.uint8)
+    raw = np.hstack([np.full((height, 1), 2, np.uint8), up]).tobytes()
+
+    def chunk(kind: bytes, body: bytes) -> bytes:
+        return struct.pack(">I", len(body)) + kind + body + struct.pack(">I", zlib.crc32(kind + body))
+
+    header = struct.pack(">IIBBBBB", width, height, 8, 0, 0, 0, 0)
+    with open(path, "wb") as fh:
+        fh.write(b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", header) + chunk(b"IDAT", zlib.compress(raw, 9))
+                 + chunk(b"IEND", b""))
+
+
+def to_gray(image: np.ndarray) -> np.ndarray:
+    """8-bit luma, 0.299 R + 0.587 G + 0.114 B rounded (ITU-R BT.601, the weights OpenCV's
+    grey conversion uses); the front-end reads every image as grey anyway."""
+    if image.ndim == 2:
+        return image.astype(np.uint8)
+    rgb = image[..., :3].astype(np.int32)
+    # cvtColor's fixed-point form: 14-bit coefficients, rounded.
+    luma = (rgb[..., 0] * 4899 + rgb[..., 1] * 9617 + rgb[..., 2] * 1868 + (1 << 13)) >> 14
+    return luma.astype(np.uint8)

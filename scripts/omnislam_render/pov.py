@@ -14,7 +14,7 @@ import time
 from pathlib import Path
 
 from . import mirror as M
-from .pngio import strip_timestamps
+from .pngio import read_ppm, strip_timestamps, to_gray, write_png_gray
 
 # Height band (around each lobe) used with the annulus to clip the implicit
 # surfaces: wide enough to hold the lobe, narrow enough to exclude the other
@@ -101,14 +101,20 @@ def povray_binary(wait_s: float = 600.0) -> str:
 
 
 def render(pov_file: Path, png_file: Path, width: int = M.IMAGE_PX, height: int = M.IMAGE_PX,
-           threads: int = 2, antialias: str | None = "+A0.1 +AM2 +R2") -> float:
-    """Render deterministically (no jitter) to an 8-bit PNG; returns wall seconds."""
-    args = [povray_binary(), f"+I{pov_file}", f"+O{png_file}", f"+W{width}", f"+H{height}",
-            "+FN8", "-D", "-V", f"+WT{threads}", "-J"]
+           threads: int = 2, antialias: str | None = "+A0.1 +AM2 +R2", grey: bool = False) -> float:
+    """Render deterministically (no jitter) to an 8-bit PNG (RGB, or grey luma); returns
+    wall seconds."""
+    out_file = Path(png_file).with_suffix(".ppm") if grey else png_file
+    args = [povray_binary(), f"+I{pov_file}", f"+O{out_file}", f"+W{width}", f"+H{height}",
+            "+FP8" if grey else "+FN8", "-D", "-V", f"+WT{threads}", "-J"]
     args += antialias.split() if antialias else ["-A"]
     start = time.monotonic()
     proc = subprocess.run(args, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-    if proc.returncode != 0 or not Path(png_file).exists():
+    if proc.returncode != 0 or not Path(out_file).exists():
         raise RuntimeError(f"povray failed on {pov_file}:\n{proc.stderr[-3000:]}")
-    strip_timestamps(png_file)
+    if grey:
+        write_png_gray(png_file, to_gray(read_ppm(out_file)))
+        Path(out_file).unlink()
+    else:
+        strip_timestamps(png_file)
     return time.monotonic() - start

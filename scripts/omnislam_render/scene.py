@@ -35,6 +35,22 @@ def polygon_segments(points: Sequence[tuple[float, float]]) -> list[Segment]:
     return [(*points[i], *points[(i + 1) % len(points)]) for i in range(len(points))]
 
 
+def inset_outline(points: Sequence[tuple[float, float]], depth: float) -> list[tuple[float, float]]:
+    """The axis-aligned, counter-clockwise polygon moved inwards by `depth` on every edge."""
+    out = []
+    n = len(points)
+    for i in range(n):
+        (xp, yp), (x, y), (xn, yn) = points[i - 1], points[i], points[(i + 1) % n]
+        shift = [0.0, 0.0]
+        for (ax, ay), (bx, by) in (((xp, yp), (x, y)), ((x, y), (xn, yn))):
+            length = math.hypot(bx - ax, by - ay)
+            # inward normal of a counter-clockwise edge: the edge direction turned left
+            shift[0] += -(by - ay) / length * depth
+            shift[1] += (bx - ax) / length * depth
+        out.append((x + shift[0], y + shift[1]))
+    return out
+
+
 def circle_segments(cx: float, cy: float, r: float, sides: int = CIRCLE_SIDES) -> list[Segment]:
     """Polygon with `sides` vertices on the circle (a cylinder's plan outline)."""
     pts = [(cx + r * math.cos(2 * math.pi * i / sides), cy + r * math.sin(2 * math.pi * i / sides))
@@ -49,9 +65,9 @@ class Box:
     hi: tuple[float, float, float]
     colour: Colour
 
-    def pov(self) -> str:
+    def pov(self, finish: str = MATT) -> str:
         return (f"box {{ {vec(*_mm(*self.lo))}, {vec(*_mm(*self.hi))} "
-                f"pigment {{ {_rgb(self.colour)} }} {MATT} }}  // {self.name}")
+                f"pigment {{ {_rgb(self.colour)} }} {finish} }}  // {self.name}")
 
     def outline(self) -> list[Segment]:
         (x0, y0, _), (x1, y1, _) = self.lo, self.hi
@@ -72,10 +88,10 @@ class Cylinder:
     z1: float
     colour: Colour
 
-    def pov(self) -> str:
+    def pov(self, finish: str = MATT) -> str:
         cx, cy = self.centre
         return (f"cylinder {{ {vec(*_mm(cx, cy, self.z0))}, {vec(*_mm(cx, cy, self.z1))}, "
-                f"{num(self.radius * 1000)} pigment {{ {_rgb(self.colour)} }} {MATT} }}  // {self.name}")
+                f"{num(self.radius * 1000)} pigment {{ {_rgb(self.colour)} }} {finish} }}  // {self.name}")
 
     def outline(self) -> list[Segment]:
         return circle_segments(*self.centre, self.radius)
@@ -91,9 +107,9 @@ class Sphere:
     radius: float
     colour: Colour
 
-    def pov(self) -> str:
+    def pov(self, finish: str = MATT) -> str:
         return (f"sphere {{ {vec(*_mm(*self.centre))}, {num(self.radius * 1000)} "
-                f"pigment {{ {_rgb(self.colour)} }} {MATT} }}  // {self.name}")
+                f"pigment {{ {_rgb(self.colour)} }} {finish} }}  // {self.name}")
 
     def outline(self) -> list[Segment]:
         return circle_segments(self.centre[0], self.centre[1], self.radius)
@@ -116,6 +132,52 @@ class Patch:
 
 
 @dataclass
+class AreaLamp:
+    """A ceiling panel or pendant: a rectangular area light (soft shadows), sampled on a
+    fixed grid (no jitter, so renders stay deterministic), with 1/d^2 falloff."""
+    centre: tuple[float, float, float]
+    size: tuple[float, float]   # extent along x and y (m)
+    power: float
+    samples: int = 5
+
+    def pov(self) -> str:
+        sx, sy = _mm(*self.size)
+        return (f"light_source {{ {vec(*_mm(*self.centre))} color rgb {num(self.power)} "
+                f"area_light {vec(sx, 0, 0)}, {vec(0, sy, 0)}, {self.samples}, {self.samples} adaptive 1 "
+                f"fade_distance 2500 fade_power 2 }}")
+
+
+@dataclass
+class Sun:
+    """Sunlight entering through a window (a Patch of the room): a parallel light from
+    outside, restricted to the window opening, drawing a bright patch on the floor."""
+    window: str            # name of the Patch it shines through
+    azimuth_deg: float     # direction towards the sun, in the room frame
+    elevation_deg: float
+    power: float
+
+
+@dataclass
+class Rug:
+    """A thin rug or mat lying on the floor: floor texture, not an obstacle (not in the
+    floor plan)."""
+    name: str
+    lo: tuple[float, float]
+    hi: tuple[float, float]
+    thickness: float
+    texture: str           # POV texture text, millimetres, room frame
+
+
+@dataclass
+class Skirting:
+    """Skirting boards along every wall: the floor contact moves to their face, which the
+    floor plan follows."""
+    height: float
+    depth: float
+    colour: Colour
+
+
+@dataclass
 class Room:
     name: str
     outline: list[tuple[float, float]]      # interior polygon, counter-clockwise, axis-aligned
@@ -126,13 +188,26 @@ class Room:
     objects: list = field(default_factory=list)
     patches: list[Patch] = field(default_factory=list)
     lights: list[tuple[tuple[float, float, float], float]] = field(default_factory=list)
+    # Realistic rooms (all optional; the flat-shaded rooms leave them unset).
+    floor_texture: str | None = None      # POV texture text replacing floor_colour
+    finish: str = MATT
+    area_lamps: list[AreaLamp] = field(default_factory=list)
+    sun: Sun | None = None
+    rugs: list[Rug] = field(default_factory=list)
+    skirting: Skirting | None = None
 
     # ---------------------------------------------------------------- geometry
     def walls(self) -> list[Segment]:
         return polygon_segments(self.outline)
 
+    def inner_faces(self) -> list[Segment]:
+        """Where the walls meet the floor: the walls, or the skirting boards' faces."""
+        if self.skirting is None:
+            return self.walls()
+        return polygon_segments(inset_outline(self.outline, self.skirting.depth))
+
     def floorplan(self) -> list[Segment]:
-        segs = list(self.walls())
+        segs = list(self.inner_faces())
         for obj in self.objects:
             segs.extend(obj.outline())
         return segs
@@ -140,7 +215,7 @@ class Room:
     def clearance(self, x: float, y: float) -> tuple[float, str]:
         """Smallest plan distance (m) from (x, y) to a wall or object, and its name."""
         best = (math.inf, "")
-        for i, (x1, y1, x2, y2) in enumerate(self.walls()):
+        for i, (x1, y1, x2, y2) in enumerate(self.inner_faces()):
             dx, dy = x2 - x1, y2 - y1
             t = max(0.0, min(1.0, ((x - x1) * dx + (y - y1) * dy) / (dx * dx + dy * dy)))
             d = math.hypot(x - x1 - t * dx, y - y1 - t * dy)
@@ -173,20 +248,66 @@ class Room:
                 phi = (max(pa[0], pb[0]), max(pa[1], pb[1]), p.z1)
                 pigment = (f"object {{ box {{ {vec(*_mm(*plo))}, {vec(*_mm(*phi))} }} "
                            f"pigment {{ {pigment} }} pigment {{ {_rgb(p.colour)} }} }}")
+            # Realistic rooms: walls cast no shadow, so the sun reaches the room through a
+            # window that is only painted on the wall (the light is restricted to it).
+            shadow = " no_shadow" if self.sun is not None else ""
             out.append(f"box {{ {vec(*_mm(*lo))}, {vec(*_mm(*hi))} pigment {{ {pigment} }} "
-                       f"{MATT} }}  // wall {i}")
+                       f"{self.finish}{shadow} }}  // wall {i}")
+        return out
+
+    def _patch_box(self, patch: Patch, thickness: float) -> tuple[tuple, tuple]:
+        x1, y1, x2, y2 = self.walls()[patch.wall]
+        length = math.hypot(x2 - x1, y2 - y1)
+        ux, uy = (x2 - x1) / length, (y2 - y1) / length
+        nx, ny = uy, -ux
+        pa = (x1 + ux * patch.s0, y1 + uy * patch.s0)
+        pb = (x1 + ux * patch.s1 + nx * thickness, y1 + uy * patch.s1 + ny * thickness)
+        return ((min(pa[0], pb[0]), min(pa[1], pb[1]), patch.z0),
+                (max(pa[0], pb[0]), max(pa[1], pb[1]), patch.z1))
+
+    def _sun_pov(self) -> str:
+        sun = self.sun
+        patch = next(p for p in self.patches if p.name == sun.window)
+        lo, hi = self._patch_box(patch, WALL_THICKNESS)
+        centre = [(a + b) / 2 for a, b in zip(lo, hi)]
+        az, el = math.radians(sun.azimuth_deg), math.radians(sun.elevation_deg)
+        towards = (math.cos(el) * math.cos(az), math.cos(el) * math.sin(az), math.sin(el))
+        source = [c + 0.8 * t for c, t in zip(centre, towards)]
+        return (f"light_source {{ {vec(*_mm(*source))} color rgb {num(sun.power)} parallel "
+                f"point_at {vec(*_mm(*centre))} projected_through {{ box {{ {vec(*_mm(*lo))}, "
+                f"{vec(*_mm(*hi))} }} }} }}  // sun through {sun.window}")
+
+    def _skirting_pov(self) -> list[str]:
+        sk = self.skirting
+        inner = inset_outline(self.outline, sk.depth)
+        out = []
+        for (x1, y1, x2, y2), (a1, b1, a2, b2) in zip(self.walls(), polygon_segments(inner)):
+            lo = (min(x1, x2, a1, a2), min(y1, y2, b1, b2), 0.0)
+            hi = (max(x1, x2, a1, a2), max(y1, y2, b1, b2), sk.height)
+            out.append(f"box {{ {vec(*_mm(*lo))}, {vec(*_mm(*hi))} pigment {{ {_rgb(sk.colour)} }} "
+                       f"{self.finish} }}  // skirting")
         return out
 
     def pov_body(self) -> str:
         """The room in world coordinates (mm), without the pose transform."""
+        floor = self.floor_texture or f"pigment {{ {_rgb(self.floor_colour)} }} {self.finish}"
+        ceiling_shadow = " no_shadow" if self.sun is not None else ""
         parts = [
-            f"plane {{ z, 0 pigment {{ {_rgb(self.floor_colour)} }} {MATT} }}  // floor",
-            f"plane {{ -z, {num(-self.height * 1000)} pigment {{ {_rgb(self.ceiling_colour)} }} {MATT} }}  // ceiling",
+            f"plane {{ z, 0 {floor} }}  // floor",
+            f"plane {{ -z, {num(-self.height * 1000)} pigment {{ {_rgb(self.ceiling_colour)} }} "
+            f"{self.finish}{ceiling_shadow} }}  // ceiling",
         ]
         parts += self._wall_boxes()
-        parts += [obj.pov() for obj in self.objects]
+        if self.skirting is not None:
+            parts += self._skirting_pov()
+        parts += [f"box {{ {vec(*_mm(*rug.lo, 0.0))}, {vec(*_mm(*rug.hi, rug.thickness))} {rug.texture} }}"
+                  f"  // {rug.name}" for rug in self.rugs]
+        parts += [obj.pov(self.finish) for obj in self.objects]
         parts += [f"light_source {{ {vec(*_mm(*pos))} color rgb {num(power)} shadowless }}"
                   for pos, power in self.lights]
+        parts += [lamp.pov() for lamp in self.area_lamps]
+        if self.sun is not None:
+            parts.append(self._sun_pov())
         return "\n  ".join(parts)
 
     def scene_hash(self) -> str:

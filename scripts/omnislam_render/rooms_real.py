@@ -1,0 +1,124 @@
+"""Realistic rooms: real floor materials, skirting boards, area lamps with soft shadows and
+sunlight through a window (issue "real floors, real light, real sensors").
+
+The geometry of sim-room and l-room is unchanged (same walls, objects and poses as the
+flat-shaded datasets), only their look; office is a room of its own, seen from a camera
+0.8 m above the floor.  Materials are POV-Ray textures in millimetres in the room frame,
+so they move with the room.  Sensor effects (noise, blur, vignetting, JPEG, exposure,
+dust) are not rendered: `omnislam degrade` / `replay --degrade` add them, seeded.
+"""
+from __future__ import annotations
+
+from .rooms import BOXES, CABINET, CEILING, DOOR, TABLE_FOOT, TABLE_TOP, WALLS, WINDOW, l_room, sim_room
+from .scene import AreaLamp, Box, Cylinder, Patch, Room, Rug, Skirting, Sun
+
+# Indirect light is approximated by a low ambient term; the lamps do the rest.
+FINISH = "finish { ambient 0.12 diffuse 0.8 }"
+GLOSSY = "finish { ambient 0.12 diffuse 0.75 specular 0.15 roughness 0.04 }"
+SKIRTING_HEIGHT = 0.08
+SKIRTING_DEPTH = 0.012
+
+
+def _rgb(c) -> str:
+    return f"rgb <{c[0]}, {c[1]}, {c[2]}>"
+
+
+def ceramic_tiles(size_mm: float = 400.0, joint_mm: float = 6.0) -> str:
+    """Square ceramic tiles with light grout joints; each tile a slightly different shade
+    (POV `cells`, one random value per tile), a little gloss."""
+    joint = (f"function {{ max(select(mod(x + 400000, {size_mm}) - {joint_mm}, 1, 0), "
+             f"select(mod(y + 400000, {size_mm}) - {joint_mm}, 1, 0)) }}")
+    tile = (f"pigment {{ cells color_map {{ [0 rgb <0.36, 0.33, 0.29>] [1 rgb <0.46, 0.42, 0.37>] }} "
+            f"scale {size_mm} translate <0, 0, {size_mm / 2}> }} {GLOSSY}")
+    grout = f"pigment {{ rgb <0.74, 0.72, 0.68> }} {FINISH}"
+    return f"texture {{ {joint} texture_map {{ [0.5 {tile}] [0.5 {grout}] }} }}"
+
+
+def wood_planks(length_mm: float = 1200.0, width_mm: float = 150.0) -> str:
+    """Staggered wooden planks along x with dark joints and grain along each plank."""
+    grain = ("pigment { wood turbulence 0.08 color_map { [0 rgb <0.40, 0.26, 0.14>] "
+             "[0.5 rgb <0.52, 0.35, 0.19>] [1 rgb <0.40, 0.26, 0.14>] } scale 9 rotate y*90 }")
+    return (f"texture {{ brick texture {{ pigment {{ rgb <0.12, 0.08, 0.05> }} {FINISH} }} "
+            f"texture {{ {grain} {GLOSSY} }} brick_size <{length_mm}, {width_mm}, 1000> mortar 3 "
+            f"translate <0, 0, 500> }}")
+
+
+def patterned_carpet(cell_mm: float = 120.0) -> str:
+    """Office carpet: a three-tone hexagon pattern."""
+    hexagons = (f"pigment {{ hexagon rgb <0.30, 0.34, 0.44>, rgb <0.40, 0.44, 0.56>, rgb <0.24, 0.27, 0.34> "
+                f"scale {cell_mm} rotate x*90 }}")
+    return f"texture {{ {hexagons} {FINISH} }}"
+
+
+def rug_texture(x0: float, y0: float, x1: float, y1: float, border_m: float = 0.12) -> str:
+    """A rug with a plain border around a field of diamonds."""
+    lo, hi = (x0 * 1000, y0 * 1000), (x1 * 1000, y1 * 1000)
+    inside = (f"function {{ select(min(x - {lo[0]}, {hi[0]} - x, y - {lo[1]}, {hi[1]} - y) - "
+              f"{border_m * 1000}, 1, 0) }}")
+    field = ("pigment { checker rgb <0.62, 0.18, 0.14>, rgb <0.80, 0.66, 0.42> scale 110 rotate z*45 "
+             "translate <0, 0, 55> }")
+    border = "pigment { rgb <0.20, 0.16, 0.30> }"
+    return f"texture {{ {inside} texture_map {{ [0.5 {field} {FINISH}] [0.5 {border} {FINISH}] }} }}"
+
+
+def _realistic(room: Room, floor: str, lamps: list[AreaLamp], sun: Sun | None, skirting_colour,
+               rugs: list[Rug] = ()) -> Room:
+    room.name += "-real"
+    room.floor_texture = floor
+    room.finish = FINISH
+    room.lights = []
+    room.area_lamps = lamps
+    room.sun = sun
+    room.rugs = list(rugs)
+    room.skirting = Skirting(SKIRTING_HEIGHT, SKIRTING_DEPTH, skirting_colour)
+    return room
+
+
+def sim_room_real() -> Room:
+    """sim-room with ceramic tiles, two square ceiling panels and the afternoon sun through
+    the window of the bottom wall, drawing a patch across the middle of the path."""
+    lamps = [AreaLamp((-2.0, 0.0, 2.95), (0.6, 0.6), 0.55), AreaLamp((1.5, 0.0, 2.95), (0.6, 0.6), 0.55)]
+    sun = Sun("window", azimuth_deg=-110.0, elevation_deg=35.0, power=1.4)
+    return _realistic(sim_room(), ceramic_tiles(), lamps, sun, (0.92, 0.92, 0.90))
+
+
+def l_room_real() -> Room:
+    """l-room with oak planks, a rug in the long arm's free corner, three pendant lamps (soft
+    shadows of the tables on the floor) and morning sun through the long wall's window."""
+    lamps = [AreaLamp((1.4, 1.0, 2.4), (0.3, 0.3), 0.40), AreaLamp((3.5, 1.0, 2.4), (0.3, 0.3), 0.40),
+             AreaLamp((1.0, 3.2, 2.4), (0.3, 0.3), 0.35)]
+    sun = Sun("window", azimuth_deg=-65.0, elevation_deg=40.0, power=1.3)
+    rug = Rug("rug", (2.6, 1.7), (4.4, 2.8), 0.008, rug_texture(2.6, 1.7, 4.4, 2.8))
+    return _realistic(l_room(), wood_planks(), lamps, sun, (0.30, 0.22, 0.15), [rug])
+
+
+def _legged_table(name: str, x0: float, y0: float, x1: float, y1: float, height: float) -> list:
+    top = Box(f"{name} top", (x0, y0, height - 0.03), (x1, y1, height), TABLE_TOP)
+    legs = [Box(f"{name} leg {k + 1}", (lx, ly, 0.0), (lx + 0.05, ly + 0.05, height - 0.03), TABLE_FOOT)
+            for k, (lx, ly) in enumerate(((x0 + 0.05, y0 + 0.05), (x1 - 0.10, y0 + 0.05),
+                                          (x1 - 0.10, y1 - 0.10), (x0 + 0.05, y1 - 0.10)))]
+    return [top, *legs]
+
+
+def office_real() -> Room:
+    """An open office, 7.0 x 5.2 m, 2.8 m high: carpet, a round pillar in the middle, a desk,
+    a sofa, a bookshelf, a low table and a bin; fluorescent panels and low winter sun through
+    a wide window.  The path (datasets.py) loops around the pillar."""
+    outline = [(0.0, 0.0), (7.0, 0.0), (7.0, 5.2), (0.0, 5.2)]  # walls: 0 bottom, 1 right, 2 top, 3 left
+    objects = [
+        Cylinder("pillar", (3.5, 2.6), 0.2, 0.0, 2.8, (0.85, 0.85, 0.82)),
+        *_legged_table("desk", 0.4, 3.9, 2.0, 4.7, 0.74),
+        Box("sofa", (4.5, 0.3, 0.0), (6.5, 1.2, 0.8), (0.35, 0.38, 0.30)),
+        Box("bookshelf", (6.65, 2.0, 0.0), (7.0, 3.2, 1.8), CABINET),
+        *_legged_table("low table", 4.4, 4.0, 5.2, 4.6, 0.45),
+        Cylinder("bin", (0.4, 0.4), 0.15, 0.0, 0.4, BOXES[2]),
+    ]
+    patches = [
+        Patch("window", 0, 2.5, 4.5, 0.9, 2.0, WINDOW),       # wall 0: (0, 0) -> (7, 0)
+        Patch("door", 2, 0.6, 1.5, 0.0, 2.0, DOOR),           # wall 2: (7, 5.2) -> (0, 5.2)
+    ]
+    lamps = [AreaLamp((x, y, 2.75), (1.2, 0.3), 0.30) for x in (1.8, 5.2) for y in (1.6, 3.6)]
+    sun = Sun("window", azimuth_deg=-100.0, elevation_deg=25.0, power=1.2)
+    room = Room("office", outline, [WALLS[0], WALLS[3], WALLS[0], WALLS[3]], (0.2, 0.2, 0.2), CEILING, 2.8,
+                objects, patches)
+    return _realistic(room, patterned_carpet(), lamps, sun, (0.92, 0.92, 0.90))
