@@ -159,8 +159,13 @@ int main(int argc, char **argv) {
                 total.quantile(0.5) - dp.quantile(0.5) + sgbm_match.quantile(0.5));
     if (!frames.poses.empty()) {
       std::printf("accuracy against floorplan.csv:\n");
-      print_accuracy("DP (default)", frames, frames.config);
+      print_accuracy("floor boundary (default)", frames, frames.config);
       ScanConfig variant = frames.config;
+      variant.stereo.floor.floor_plane_range = false;
+      print_accuracy("floor boundary, stereo range", frames, variant);
+      variant = frames.config;
+      variant.stereo.boundary = omnislam::stereo::BoundaryMethod::kNearestEdge;
+      print_accuracy("nearest edge + DP (thesis)", frames, variant);
       variant.stereo.subpixel = omnislam::stereo::SubpixelMethod::kCostCurve;
       print_accuracy("DP, cost-curve sub-pixel", frames, variant);
       variant.stereo.subpixel = omnislam::stereo::SubpixelMethod::kNone;

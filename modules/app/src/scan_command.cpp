@@ -35,6 +35,13 @@ void print_summary(const std::string &image, const stereo::LocalScan &scan) {
                "no intersection %d, outside cut-offs %d, filtered %d, points %d\n",
                image.c_str(), s.inner.candidates, s.outer.candidates, s.admissible_pairs, s.matched,
                s.no_intersection, s.outside_cutoffs, s.filtered_out, s.points);
+  if (!scan.free_range_m.empty()) {
+    std::fprintf(stderr,
+                 "%s: floor boundary: floor texture %d, floor contacts %d (undecided %d), elevated %d, "
+                 "unexplained %d, residual scale %.4f\n",
+                 image.c_str(), s.floor_texture_edges, s.floor_contacts, s.undecided, s.elevated, s.unexplained,
+                 static_cast<double>(s.noise_scale));
+  }
 }
 
 }  // namespace

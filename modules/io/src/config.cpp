@@ -110,6 +110,24 @@ void read_stereo(YamlSection &section, stereo::StereoConfig &stereo) {
       section, "triangulation", stereo.triangulation,
       {{"exact", stereo::TriangulationMethod::kExact}, {"table", stereo::TriangulationMethod::kTable}},
       "must be exact or table");
+  read_choice(section, "boundary", stereo.boundary,
+              {{"floor_boundary", stereo::BoundaryMethod::kFloorBoundary},
+               {"nearest_edge", stereo::BoundaryMethod::kNearestEdge}},
+              "must be floor_boundary or nearest_edge");
+  if (section.has("floor")) {
+    YamlSection floor = section.section("floor");
+    stereo::FloorBoundaryConfig &config = stereo.floor;
+    floor.read("max_edges_per_column", config.max_edges_per_column);
+    floor.read("contact_margin_px", config.contact_margin_px);
+    floor.read("error_rate", config.error_rate);
+    floor.read("floor_plane_range", config.floor_plane_range);
+    floor.finish();
+    if (config.max_edges_per_column < 1 || config.max_edges_per_column > 16)
+      floor.fail("max_edges_per_column", "must be 1..16");
+    if (!(config.contact_margin_px > 0.0 && config.contact_margin_px <= 10.0))
+      floor.fail("contact_margin_px", "must be in (0, 10]");
+    if (!(config.error_rate > 0.0 && config.error_rate < 0.5)) floor.fail("error_rate", "must be in (0, 0.5)");
+  }
   if (!(stereo.max_range_m > stereo.min_range_m)) section.fail("max_range_m", "must exceed min_range_m");
   if (!(stereo.far_cutoff_m > stereo.near_cutoff_m))
     section.fail("far_cutoff_m", "must exceed near_cutoff_m");

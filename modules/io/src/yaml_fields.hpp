@@ -40,6 +40,10 @@ class YamlSection {
   }
 
   [[nodiscard]] YAML::Node node(const std::string &key) const { return node_[key]; }
+  /// The sub-mapping `key` as a section of its own (its keys named "prefix.key.x").
+  [[nodiscard]] YamlSection section(const std::string &key) const {
+    return YamlSection(node_[key], prefix_.empty() ? key : prefix_ + "." + key, file_);
+  }
 
   template <typename T>
   void read(const std::string &key, T &value, const char *expected) {

@@ -58,8 +58,12 @@ ScanReconstructor::ScanReconstructor(const ScanConfig &config)
       limits_(derive_disparity_limits(model_, config.camera_height_m, config.stereo.min_range_m,
                                       config.stereo.max_range_m, config.stereo.disparity_margin_px)),
       triangulator_(model_, config.stereo.triangulation),
+      floor_geometry_(model_, config.camera_height_m),
+      selection_(config.vision.selection),
       inner_detector_(config.vision.canny),
-      outer_detector_(config.vision.canny) {
+      outer_detector_(config.vision.canny),
+      boundary_finder_(config.stereo.floor) {
+  if (floor_boundary()) selection_.max_edges_per_column = config.stereo.floor.max_edges_per_column;
   if (config.vision.selection.blackman_smoothing) blackman_ = vision::blackman_kernel(7);
   for (int column = 0; column < config.camera.columns; ++column) {
     const double azimuth =
@@ -110,17 +114,23 @@ void ScanReconstructor::detect_edges() {
 void ScanReconstructor::select_edges() {
   for (LobeWork *work : {&inner_, &outer_}) {
     vision::make_texture(work->panorama, blackman_, work->texture);
-    work->selection = vision::select_nearest_horizontal_edges(work->edges, work->texture,
-                                                              config_.vision.selection, work->candidates);
+    work->selection =
+        vision::select_nearest_horizontal_edges(work->edges, work->texture, selection_, work->candidates);
   }
 }
 
 void ScanReconstructor::match() {
   matches_.clear();
   match_stats_ = {};
+  if (floor_boundary()) {
+    boundary_stats_ = boundary_finder_.find(floor_geometry_, inner_.texture, outer_.texture, inner_.edges, outer_.edges,
+                                            inner_.candidates, outer_.candidates, limits_, triangulator_, selection_,
+                                            boundary_points_, free_range_m_);
+    return;
+  }
   for (int column = 0; column < inner_.candidates.columns(); ++column) {
     match_column(inner_.candidates.column(column), outer_.candidates.column(column), column, inner_.texture,
-                 outer_.texture, limits_, config_.vision.selection, config_.stereo, matches_, match_stats_);
+                 outer_.texture, limits_, selection_, config_.stereo, matches_, match_stats_);
   }
 }
 
@@ -136,26 +146,53 @@ void ScanReconstructor::triangulate(LocalScan &scan) {
   scan.stats.matched = match_stats_.matched;
   scan.stats.occluded_inner = match_stats_.occluded_inner;
   scan.stats.occluded_outer = match_stats_.occluded_outer;
-  build_scan(matches_, scan);
+  if (floor_boundary()) {
+    build_boundary_scan(scan);
+  } else {
+    build_scan(matches_, scan);
+  }
+}
+
+void ScanReconstructor::add_point(int column, double range_m, double height_m, float inner_row, float outer_row,
+                                  LocalScan &scan) {
+  if (range_m < config_.stereo.near_cutoff_m || range_m > config_.stereo.far_cutoff_m) {
+    ++scan.stats.outside_cutoffs;
+    return;
+  }
+  const auto c = static_cast<std::size_t>(column);
+  scan.points.push_back({column_azimuth_rad_[c], range_m, range_m * column_cos_[c], range_m * column_sin_[c],
+                         config_.camera_height_m + height_m, inner_row, outer_row});
+}
+
+void ScanReconstructor::build_boundary_scan(LocalScan &scan) {
+  scan.points.clear();
+  scan.stats.matched = static_cast<int>(boundary_points_.size());
+  scan.stats.floor_texture_edges = boundary_stats_.floor_texture;
+  scan.stats.floor_contacts = boundary_stats_.floor_contacts;
+  scan.stats.undecided = boundary_stats_.undecided;
+  scan.stats.elevated = boundary_stats_.elevated;
+  scan.stats.unexplained = boundary_stats_.unexplained;
+  scan.stats.noise_scale = boundary_stats_.noise_scale;
+  for (const BoundaryPoint &point : boundary_points_) {
+    add_point(point.column, point.range_m, point.height_m, point.inner_row, point.outer_row, scan);
+  }
+  // One boundary per column already; the per-degree filter matters only for finer panoramas.
+  if (config_.stereo.one_point_per_degree) scan.stats.filtered_out = keep_nearest_per_degree(scan.points, filtered_);
+  scan.stats.points = static_cast<int>(scan.points.size());
+  scan.free_range_m = free_range_m_;
 }
 
 void ScanReconstructor::build_scan(const std::vector<RowMatch> &matches, LocalScan &scan) {
   const StereoConfig &stereo = config_.stereo;
   scan.points.clear();
+  scan.free_range_m.clear();
   for (const RowMatch &match : matches) {
     const auto point = triangulator_.triangulate(match.inner_row, match.outer_row);
     if (!point) {
       ++scan.stats.no_intersection;
       continue;
     }
-    if (point->range_m < stereo.near_cutoff_m || point->range_m > stereo.far_cutoff_m) {
-      ++scan.stats.outside_cutoffs;
-      continue;
-    }
-    const auto column = static_cast<std::size_t>(match.column);
-    scan.points.push_back({column_azimuth_rad_[column], point->range_m, point->range_m * column_cos_[column],
-                           point->range_m * column_sin_[column], config_.camera_height_m + point->height_m,
-                           match.inner_row, match.outer_row});
+    add_point(match.column, point->range_m, point->height_m, match.inner_row, match.outer_row, scan);
   }
   if (stereo.one_point_per_degree) scan.stats.filtered_out = keep_nearest_per_degree(scan.points, filtered_);
   scan.stats.points = static_cast<int>(scan.points.size());

@@ -42,6 +42,13 @@ struct ScanStats {
   int no_intersection = 0;  ///< matches whose rays do not meet
   int outside_cutoffs = 0;  ///< points dropped by the near/far cut-offs
   int filtered_out = 0;     ///< points dropped by the one-point-per-degree filter
+  // Floor-boundary search (stereo::BoundaryMethod::kFloorBoundary), per frame:
+  int floor_texture_edges = 0;  ///< edges the floor hypothesis explained (free floor)
+  int floor_contacts = 0;       ///< boundaries on the floor
+  int undecided = 0;            ///< of which neither hypothesis won (uniform surfaces)
+  int elevated = 0;             ///< boundaries above the floor (triangulated)
+  int unexplained = 0;          ///< edges off the floor without an outer match
+  float noise_scale = 0.0f;     ///< photometric residual scale (intensity in [0, 1])
   int points = 0;           ///< points in the scan
 };
 
@@ -53,6 +60,10 @@ enum class ScanStatus {
 struct LocalScan {
   ScanStatus status = ScanStatus::kOk;
   std::vector<ScanPoint> points;  ///< ordered by azimuth, then bottom-up within a column
+  /// Per panorama column (column j at azimuth (j + 0.5) * 360 / columns deg + the offset), how far the floor was seen to
+  /// be free (m): up to the boundary found, or up to the farthest floor texture where none
+  /// was; NaN where nothing was seen. Empty for the nearest-edge method.
+  std::vector<float> free_range_m;
   ScanStats stats;
 };
 

@@ -7,6 +7,8 @@
 #include "omnislam/mirror/mirror_model.hpp"
 #include "omnislam/stereo/column_matching.hpp"
 #include "omnislam/stereo/disparity_limits.hpp"
+#include "omnislam/stereo/floor_boundary.hpp"
+#include "omnislam/stereo/floor_geometry.hpp"
 #include "omnislam/stereo/local_scan.hpp"
 #include "omnislam/stereo/row_triangulator.hpp"
 #include "omnislam/stereo/stereo_config.hpp"
@@ -47,7 +49,7 @@ class ScanReconstructor {
   void unwarp(const cv::Mat &image);  ///< step 1, both lobes
   void detect_edges();                ///< step 2, both lobes
   void select_edges();                ///< steps 3-4, both lobes
-  void match();                       ///< step 5, every column pair
+  void match();                       ///< step 5, every column pair (or the floor-boundary search)
   void triangulate(LocalScan &scan);  ///< steps 6-7, with the stats of all steps
 
   /// Exchanges the per-frame state of both lobes (what select_edges() leaves for match())
@@ -62,17 +64,24 @@ class ScanReconstructor {
   [[nodiscard]] const LobeWork &inner() const { return inner_; }
   [[nodiscard]] const LobeWork &outer() const { return outer_; }
   [[nodiscard]] const std::vector<RowMatch> &matches() const { return matches_; }
+  [[nodiscard]] const FloorGeometry &floor_geometry() const { return floor_geometry_; }
 
   /// Turns matched rows into scan points with the configured cut-offs and filter; shared
   /// with other matchers (e.g. a benchmark's StereoSGBM) so they are judged alike.
   void build_scan(const std::vector<RowMatch> &matches, LocalScan &scan);
 
  private:
+  [[nodiscard]] bool floor_boundary() const { return config_.stereo.boundary == BoundaryMethod::kFloorBoundary; }
+  void build_boundary_scan(LocalScan &scan);
+  void add_point(int column, double range_m, double height_m, float inner_row, float outer_row, LocalScan &scan);
+
   ScanConfig config_;
   mirror::MirrorModel model_;
   vision::PanoramaUnwarper unwarper_;
   DisparityLimits limits_;
   RowTriangulator triangulator_;
+  FloorGeometry floor_geometry_;
+  vision::EdgeSelectionConfig selection_;  ///< the vision config's, with the method's edge count
   cv::Mat blackman_;
   std::vector<double> column_cos_;
   std::vector<double> column_sin_;
@@ -83,6 +92,10 @@ class ScanReconstructor {
   LobeWork outer_;
   std::vector<RowMatch> matches_;
   MatchStats match_stats_;
+  FloorBoundaryFinder boundary_finder_;
+  std::vector<BoundaryPoint> boundary_points_;
+  std::vector<float> free_range_m_;
+  BoundaryStats boundary_stats_;
   std::vector<ScanPoint> filtered_;
 };
 

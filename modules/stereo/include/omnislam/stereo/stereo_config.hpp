@@ -23,7 +23,29 @@ enum class TriangulationMethod {
   kTable,  ///< the thesis's 225x225 table at rounded integer rows (annex A1.3)
 };
 
+/// What ends the free floor in a column.
+enum class BoundaryMethod {
+  kNearestEdge,    ///< the thesis: DP-matched nearest horizontal edges (sec. 3 steps 3-5)
+  kFloorBoundary,  ///< the first edge that is not floor texture (floor_boundary.hpp)
+};
+
+/// The floor-boundary search (floor_boundary.hpp).
+struct FloorBoundaryConfig {
+  /// Horizontal edges examined per column, nearest first (a tiled floor has many).
+  int max_edges_per_column = 16;
+  /// An edge is on the floor when the outer lobe has an edge of the same polarity within
+  /// this many pixels of the row the floor predicts: the sub-pixel edge error of both lobes
+  /// (~0.2 px each) plus what a calibrated rig leaves (~0.5 px), with room to spare.
+  double contact_margin_px = 1.5;
+  /// Error rate of the floor-or-wall test (Wald's thresholds +-ln((1 - a) / a)).
+  double error_rate = 0.01;
+  /// Range of a floor contact: from the floor plane (true) or from the stereo pair.
+  bool floor_plane_range = true;
+};
+
 struct StereoConfig {
+  BoundaryMethod boundary = BoundaryMethod::kFloorBoundary;
+  FloorBoundaryConfig floor;
   /// Disparity search band, derived per inner row from the mirror model (no fixed
   /// 10..90 px): only points with horizontal range in [min_range_m, max_range_m] at or
   /// above the floor are searched for, widened by disparity_margin_px on both sides.

@@ -1,0 +1,98 @@
+#pragma once
+
+#include <opencv2/core.hpp>
+#include <vector>
+
+#include "omnislam/stereo/disparity_limits.hpp"
+#include "omnislam/stereo/floor_geometry.hpp"
+#include "omnislam/stereo/row_triangulator.hpp"
+#include "omnislam/stereo/stereo_config.hpp"
+#include "omnislam/vision/edge_detector.hpp"
+#include "omnislam/vision/edge_selection.hpp"
+
+/// @file
+/// Where free floor ends, whatever the floor looks like. Replaces "the nearest horizontal
+/// edge of each column" (thesis sec. 3 step 3), which on a textured floor is a tile joint
+/// or a shadow edge, by a test of what the two lobes see beyond each edge.
+///
+/// Per column, the horizontal edges of the inner panorama are visited from the robot
+/// outwards:
+///  1. Is the edge on the floor? A floor point seen at inner row e is seen by the outer
+///     lobe at the row the mirror model predicts from the camera height alone; an edge on
+///     the floor has an outer edge of the same polarity there (within contact_margin_px).
+///  2. If it is not, the edge is above the floor (a table top, a shelf): it is matched by
+///     window SAD among the outer edges nearer than the floor, triangulated, and ends the
+///     search. Without a match it is left unexplained (the free range stops there).
+///  3. If it is, which hypothesis explains the pixels beyond it in both lobes: the floor
+///     going on, or a vertical surface standing at the edge's range? Each row above the
+///     edge compares the photometric residual of the two hypotheses (inner pixel against
+///     the outer pixel each predicts, after a per-row gain between the lobes), and a
+///     sequential probability ratio test (Wald) accumulates them until one hypothesis wins
+///     at the configured error rate. Floor wins: the edge is floor texture, and evidence of
+///     free floor; the search goes on. The vertical surface wins, or the column ends
+///     undecided (a uniform wall explains both equally): the edge is where the floor ends.
+///     Its range is the floor range of the edge row (the floor plane is far more precise
+///     than the stereo disparity: ~16 mm per row at 1-2 m against ~130 mm per pixel of
+///     disparity, mirror.md sec. 9).
+/// The residual noise scale is measured per frame (median floor residual of the rows
+/// nearest the robot), so no threshold is in intensity units.
+
+namespace omnislam::stereo {
+
+/// A point where free floor ends in one column.
+struct BoundaryPoint {
+  int column = 0;
+  float inner_row = 0.0f;
+  float outer_row = 0.0f;
+  double range_m = 0.0;
+  double height_m = 0.0;  ///< relative to the pinhole (the floor is -camera_height_m)
+  bool on_floor = true;   ///< a floor contact (false: an edge above the floor, triangulated)
+};
+
+struct BoundaryStats {
+  int edges_visited = 0;
+  int floor_texture = 0;     ///< edges the floor hypothesis explained
+  int floor_contacts = 0;    ///< boundaries on the floor (vertical surface or undecided)
+  int undecided = 0;         ///< of which the test ran out of rows
+  int elevated = 0;          ///< boundaries above the floor (triangulated)
+  int unexplained = 0;       ///< edges off the floor without an outer match
+  float noise_scale = 0.0f;  ///< residual scale used by the test (intensity in [0, 1])
+};
+
+/// Scratch images between frames; not thread-safe (one per thread).
+class FloorBoundaryFinder {
+ public:
+  explicit FloorBoundaryFinder(const FloorBoundaryConfig &config = {});
+
+  /// Finds the boundary of every column. `inner`/`outer` textures are CV_32FC1 in [0, 1];
+  /// the candidates are every horizontal edge of each column, nearest first.
+  /// `free_range_m` gets, per column, how far the floor was seen to be free (NaN: unknown).
+  BoundaryStats find(const FloorGeometry &geometry, const cv::Mat &inner_texture, const cv::Mat &outer_texture, const vision::EdgeImage &inner_edges,
+                     const vision::EdgeImage &outer_edges, const vision::ColumnEdges &inner_candidates,
+                     const vision::ColumnEdges &outer_candidates, const DisparityLimits &limits,
+                     const RowTriangulator &triangulator, const vision::EdgeSelectionConfig &window,
+                     std::vector<BoundaryPoint> &points, std::vector<float> &free_range_m);
+
+ private:
+  void prepare(const cv::Mat &inner_texture, const cv::Mat &outer_texture);
+  /// Log-likelihood ratio, floor over vertical surface, of the rows above `edge_row`.
+  enum class Verdict { kFloor, kVertical, kUndecided };
+  [[nodiscard]] Verdict floor_or_vertical(int column, float edge_row) const;
+  [[nodiscard]] float outer_at(float row, int column) const;
+  /// Gain-compensated SAD of the inner window at `inner_row` and the outer one at
+  /// `outer_row` (fractional), on the smoothed textures.
+  [[nodiscard]] float window_cost(int inner_row, float outer_row, int column,
+                                  const vision::EdgeSelectionConfig &window) const;
+
+  const FloorGeometry *geometry_ = nullptr;  ///< of the current find() call
+  FloorBoundaryConfig config_;
+  double decision_llr_ = 0.0;
+  cv::Mat inner_;           ///< smoothed inner texture
+  cv::Mat outer_;           ///< smoothed outer texture
+  cv::Mat floor_residual_;  ///< |inner - gain * outer at the floor row|, per inner row and column
+  std::vector<float> gain_;  ///< per inner row: inner / outer brightness of the same floor point
+  std::vector<float> ratios_;
+  float noise_scale_ = 0.0f;
+};
+
+}  // namespace omnislam::stereo

@@ -1,0 +1,55 @@
+#pragma once
+
+#include <vector>
+
+#include "omnislam/mirror/mirror_model.hpp"
+
+/// @file
+/// Where the two lobes see the floor and a vertical surface standing on it. Both follow
+/// from the mirror model and the camera height alone, and are the same in every column
+/// (the model is rotationally symmetric), so they are tabulated once per camera.
+///
+/// - Floor: inner row i looks at the floor point at range floor_range_m(i); the outer lobe
+///   sees that point at floor_outer_row(i).
+/// - Vertical surface: a surface standing on the floor at the floor range of inner row e
+///   (a wall whose base is seen at e) is seen by inner row i < e at some height; the
+///   outer lobe sees that point at vertical_outer_row(i, e).
+/// Rows are continuous panorama rows (mirror.md sec. 0); NaN marks a point a lobe does not
+/// see (or a ray that never meets the floor).
+
+namespace omnislam::stereo {
+
+class FloorGeometry {
+ public:
+  FloorGeometry(const mirror::MirrorModel &model, double camera_height_m);
+
+  [[nodiscard]] int rows() const { return rows_; }
+  [[nodiscard]] double camera_height_m() const { return camera_height_m_; }
+  /// Floor range of integer inner row i (m); NaN at or above the horizon.
+  [[nodiscard]] float floor_range_m(int inner_row) const { return floor_range_m_[index(inner_row)]; }
+  /// Floor range of a fractional inner row (exact, from the mirror model).
+  [[nodiscard]] double floor_range_at(double inner_row) const;
+  /// Outer row of the floor point of integer inner row i.
+  [[nodiscard]] float floor_outer_row(int inner_row) const { return floor_outer_row_[index(inner_row)]; }
+  /// The same at a fractional inner row (linear between rows; NaN if either is unseen).
+  [[nodiscard]] float floor_outer_row_at(float inner_row) const;
+  /// Outer row of the point of inner row `row` on the vertical surface whose base is the
+  /// floor point of inner row `base_row` (row < base_row; NaN otherwise or when unseen).
+  [[nodiscard]] float vertical_outer_row(int row, int base_row) const {
+    return vertical_outer_row_[index(base_row) * static_cast<std::size_t>(rows_) + index(row)];
+  }
+  /// The same for a fractional base row (linear between the two base rows around it).
+  [[nodiscard]] float vertical_outer_row_at(int row, float base_row) const;
+
+ private:
+  [[nodiscard]] static std::size_t index(int row) { return static_cast<std::size_t>(row); }
+
+  mirror::MirrorModel model_;
+  double camera_height_m_ = 0.0;
+  int rows_ = 0;
+  std::vector<float> floor_range_m_;
+  std::vector<float> floor_outer_row_;
+  std::vector<float> vertical_outer_row_;  ///< [base_row][row]
+};
+
+}  // namespace omnislam::stereo

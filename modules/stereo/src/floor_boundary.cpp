@@ -1,0 +1,233 @@
+#include "omnislam/stereo/floor_boundary.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <numbers>
+#include <opencv2/imgproc.hpp>
+
+
+namespace omnislam::stereo {
+namespace {
+
+constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
+// 8-bit images cannot resolve less than one grey level.
+constexpr float kMinNoiseScale = 1.0f / 255.0f;
+// Below this the ratio of two intensities says nothing (the black surround, deep shadow).
+constexpr float kDarkLevel = 0.02f;
+// Each row's vote is capped (an occlusion edge or a highlight is one bad row, not proof)
+// and halved: the residuals of neighbouring rows share the 5x5 smoothing.
+constexpr float kMaxRowVote = 3.0f;
+constexpr float kRowCorrelation = 0.5f;
+constexpr float kDeadZone = 0.5f;
+// The 7 x 3 similarity window's pixels share the smoothing in both directions.
+constexpr float kWindowCorrelation = 0.25f;
+// An edge spreads over +-3 rows after the detector's and the residual's smoothing.
+constexpr int kEdgeBlurRows = 3;
+
+int polarity(const vision::EdgeImage &edges, int row, int column) {
+  return edges.grad_row.at<std::int16_t>(row, column) >= 0 ? 1 : -1;
+}
+
+float median_of(std::vector<float> &values) {
+  if (values.empty()) return kNaN;
+  const auto middle = values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2);
+  std::nth_element(values.begin(), middle, values.end());
+  return *middle;
+}
+
+}  // namespace
+
+FloorBoundaryFinder::FloorBoundaryFinder(const FloorBoundaryConfig &config)
+    : config_(config), decision_llr_(std::log((1.0 - config.error_rate) / config.error_rate)) {}
+
+float FloorBoundaryFinder::outer_at(float row, int column) const {
+  const float clamped = std::clamp(row, 0.0f, static_cast<float>(outer_.rows - 1));
+  const int below = std::min(outer_.rows - 2, static_cast<int>(clamped));
+  const float fraction = clamped - static_cast<float>(below);
+  const float a = outer_.at<float>(below, column), b = outer_.at<float>(below + 1, column);
+  return a + fraction * (b - a);
+}
+
+void FloorBoundaryFinder::prepare(const cv::Mat &inner_texture, const cv::Mat &outer_texture) {
+  cv::GaussianBlur(inner_texture, inner_, cv::Size(5, 5), 1.0, 1.0, cv::BORDER_REPLICATE);
+  cv::GaussianBlur(outer_texture, outer_, cv::Size(5, 5), 1.0, 1.0, cv::BORDER_REPLICATE);
+  const int rows = inner_.rows, columns = inner_.cols;
+  gain_.assign(static_cast<std::size_t>(rows), 1.0f);
+  floor_residual_.create(rows, columns, CV_32FC1);
+  floor_residual_.setTo(kNaN);
+  // Per row, the brightness ratio of the two lobes on what the floor hypothesis pairs: the
+  // lobes differ by vignetting and mirror reflectance, both functions of the image radius.
+  for (int row = 0; row < rows; ++row) {
+    const float outer_row = geometry_->floor_outer_row(row);
+    float &gain = gain_[static_cast<std::size_t>(row)];
+    gain = 1.0f;
+    if (!std::isfinite(outer_row)) continue;
+    ratios_.clear();
+    for (int column = 0; column < columns; ++column) {
+      const float inner = inner_.at<float>(row, column), outer = outer_at(outer_row, column);
+      if (inner > kDarkLevel && outer > kDarkLevel) ratios_.push_back(inner / outer);
+    }
+    if (ratios_.size() * 10 >= static_cast<std::size_t>(columns)) gain = median_of(ratios_);
+    for (int column = 0; column < columns; ++column) {
+      floor_residual_.at<float>(row, column) =
+          std::abs(inner_.at<float>(row, column) - gain * outer_at(outer_row, column));
+    }
+  }
+  // Noise scale from the rows nearest the robot, mostly floor in any room: a Laplace
+  // distribution's scale is its median absolute value over ln 2.
+  ratios_.clear();
+  for (int row = rows / 2; row < rows; ++row) {
+    for (int column = 0; column < columns; ++column) {
+      const float residual = floor_residual_.at<float>(row, column);
+      if (std::isfinite(residual)) ratios_.push_back(residual);
+    }
+  }
+  const float median = median_of(ratios_);
+  noise_scale_ = std::isfinite(median) ? std::max(kMinNoiseScale, median / std::numbers::ln2_v<float>)
+                                       : kMinNoiseScale;
+}
+
+float FloorBoundaryFinder::window_cost(int inner_row, float outer_row, int column,
+                                       const vision::EdgeSelectionConfig &window) const {
+  float sum = 0.0f;
+  const int rows = inner_.rows;
+  for (int dc = -window.half_window_columns; dc <= window.half_window_columns; ++dc) {
+    const int col = (column + dc + inner_.cols) % inner_.cols;
+    for (int dr = -window.half_window_rows; dr <= window.half_window_rows; ++dr) {
+      const int row = std::clamp(inner_row + dr, 0, rows - 1);
+      sum += std::abs(inner_.at<float>(row, col) -
+                      gain_[static_cast<std::size_t>(row)] * outer_at(outer_row + static_cast<float>(dr), col));
+    }
+  }
+  return sum;
+}
+
+FloorBoundaryFinder::Verdict FloorBoundaryFinder::floor_or_vertical(int column, float edge_row) const {
+  // Wald's sequential test, rows outwards from the edge. Both hypotheses pass through the
+  // edge's base, so near it they predict nearly the same outer row, and there the residuals
+  // measure only the sub-pixel placement of a steep edge, not the hypotheses: a row votes
+  // once the two predictions are a pixel apart (and outside the edge's own blur).
+  double llr = 0.0;
+  for (int row = static_cast<int>(edge_row) - kEdgeBlurRows; row >= 0; --row) {
+    const float floor_residual = floor_residual_.at<float>(row, column);
+    const float vertical_row = geometry_->vertical_outer_row_at(row, edge_row);
+    if (!std::isfinite(floor_residual) || !std::isfinite(vertical_row)) continue;
+    if (std::abs(vertical_row - geometry_->floor_outer_row(row)) < 1.0f) continue;
+    const float vertical_residual =
+        std::abs(inner_.at<float>(row, column) - gain_[static_cast<std::size_t>(row)] * outer_at(vertical_row, column));
+    // Laplace log-likelihood ratio of the row, less a dead zone of half the scale: what the
+    // model itself leaves (sub-pixel base, interpolation, the gain estimate) must not add up
+    // over a long uniform wall as if it were evidence.
+    const float difference = (vertical_residual - floor_residual) / noise_scale_;
+    const float vote = std::clamp(std::copysign(std::max(0.0f, std::abs(difference) - kDeadZone), difference),
+                                  -kMaxRowVote, kMaxRowVote);
+    llr += kRowCorrelation * vote;
+    if (llr >= decision_llr_) return Verdict::kFloor;
+    if (llr <= -decision_llr_) return Verdict::kVertical;
+  }
+  return Verdict::kUndecided;
+}
+
+BoundaryStats FloorBoundaryFinder::find(const FloorGeometry &geometry, const cv::Mat &inner_texture, const cv::Mat &outer_texture,
+                                        const vision::EdgeImage &inner_edges, const vision::EdgeImage &outer_edges,
+                                        const vision::ColumnEdges &inner_candidates,
+                                        const vision::ColumnEdges &outer_candidates, const DisparityLimits &limits,
+                                        const RowTriangulator &triangulator,
+                                        const vision::EdgeSelectionConfig &window,
+                                        std::vector<BoundaryPoint> &points, std::vector<float> &free_range_m) {
+  geometry_ = &geometry;
+  prepare(inner_texture, outer_texture);
+  BoundaryStats stats;
+  stats.noise_scale = noise_scale_;
+  const auto margin = static_cast<float>(config_.contact_margin_px);
+  const double floor_height_m = -geometry_->camera_height_m();
+  points.clear();
+  free_range_m.assign(static_cast<std::size_t>(inner_candidates.columns()), kNaN);
+  for (int column = 0; column < inner_candidates.columns(); ++column) {
+    const auto outer_edges_here = outer_candidates.column(column);
+    float free_end_m = kNaN;       // an edge off the floor that nothing explains
+    float farthest_floor_m = kNaN;  // the farthest edge found to be floor texture
+    float boundary_m = kNaN;
+    for (const vision::EdgePoint &edge : inner_candidates.column(column)) {
+      ++stats.edges_visited;
+      const int sign = polarity(inner_edges, edge.row, column);
+      const float floor_row = geometry_->floor_outer_row_at(edge.row_subpx);
+      // 1. Is there an outer edge of the same polarity where the floor puts it?
+      const vision::EdgePoint *contact = nullptr;
+      for (const vision::EdgePoint &outer : outer_edges_here) {
+        const float offset = std::abs(outer.row_subpx - floor_row);
+        if (offset <= margin && polarity(outer_edges, outer.row, column) == sign &&
+            (contact == nullptr || offset < std::abs(contact->row_subpx - floor_row))) {
+          contact = &outer;
+        }
+      }
+      // 2. If not, the outer edge nearer than the floor that looks most alike; it explains
+      //    the edge only when it fits decisively better than the floor's prediction (a
+      //    floor edge whose outer twin the detector missed is not a table top).
+      const vision::EdgePoint *match = nullptr;
+      if (contact == nullptr) {
+        const DisparityBand &band = limits.per_inner_row[static_cast<std::size_t>(edge.row)];
+        const float floor_disparity = floor_row - edge.row_subpx;
+        float best_cost = std::numeric_limits<float>::infinity();
+        for (const vision::EdgePoint &outer : outer_edges_here) {
+          const float disparity = outer.row_subpx - edge.row_subpx;
+          if (!band.contains(static_cast<float>(outer.row - edge.row)) ||
+              polarity(outer_edges, outer.row, column) != sign)
+            continue;
+          if (std::isfinite(floor_disparity) && !(disparity > floor_disparity + margin)) continue;
+          const float cost = window_cost(edge.row, outer.row_subpx, column, window);
+          if (cost < best_cost) best_cost = cost, match = &outer;
+        }
+        if (match != nullptr && std::isfinite(floor_row)) {
+          const float floor_cost = window_cost(edge.row, floor_row, column, window);
+          if (kWindowCorrelation * (floor_cost - best_cost) / noise_scale_ < decision_llr_) match = nullptr;
+        }
+        if (match == nullptr && !std::isfinite(floor_row)) {
+          ++stats.unexplained;
+          if (!std::isfinite(free_end_m)) free_end_m = static_cast<float>(geometry_->floor_range_at(edge.row_subpx));
+          continue;
+        }
+      }
+      if (match != nullptr) {
+        const auto stereo = triangulator.triangulate(edge.row_subpx, match->row_subpx);
+        if (!stereo) continue;
+        ++stats.elevated;
+        points.push_back({column, edge.row_subpx, match->row_subpx, stereo->range_m, stereo->height_m, false});
+        boundary_m = static_cast<float>(stereo->range_m);
+        break;
+      }
+      // 3. On the floor: floor going on, or a vertical surface standing here?
+      const float outer_row = contact != nullptr ? contact->row_subpx : floor_row;
+      const Verdict verdict = floor_or_vertical(column, edge.row_subpx);
+      const auto range_m = static_cast<float>(geometry_->floor_range_at(edge.row_subpx));
+      if (verdict == Verdict::kFloor) {
+        ++stats.floor_texture;
+        farthest_floor_m = range_m;
+        continue;
+      }
+      ++stats.floor_contacts;
+      if (verdict == Verdict::kUndecided) ++stats.undecided;
+      BoundaryPoint point{column, edge.row_subpx, outer_row, range_m, floor_height_m, true};
+      if (!config_.floor_plane_range) {
+        const auto stereo = triangulator.triangulate(edge.row_subpx, outer_row);
+        if (!stereo) continue;
+        point.range_m = stereo->range_m;
+        point.height_m = stereo->height_m;
+      }
+      points.push_back(point);
+      boundary_m = static_cast<float>(point.range_m);
+      break;
+    }
+    float &free_m = free_range_m[static_cast<std::size_t>(column)];
+    if (std::isfinite(boundary_m)) {
+      free_m = std::isfinite(free_end_m) ? std::min(free_end_m, boundary_m) : boundary_m;
+    } else {
+      free_m = std::isfinite(free_end_m) ? free_end_m : farthest_floor_m;
+    }
+  }
+  return stats;
+}
+
+}  // namespace omnislam::stereo
