@@ -91,6 +91,61 @@ TEST_CASE("config: unknown keys and wrong types name the key and file:line", "[i
                     Catch::Contains("/nonexistent/omnislam.yaml"));
 }
 
+TEST_CASE("config: the degradation section, per factor, with errors naming key and line", "[io][config]") {
+  const fs::path file =
+      write_file("degradation.yaml",
+                 "degradation:\n"
+                 "  seed: 42\n"
+                 "  center_px: [500.0, 510.5]\n"
+                 "  exposure: {max_change: 0.05}\n"
+                 "  vignetting: {enabled: false, rim_falloff: 0.2, rim_radius_px: 480}\n"
+                 "  dust: {count: 3, min_radius_px: 1, max_radius_px: 2, max_opacity: 0.5}\n"
+                 "  blur: {radius_px: 1.5}\n"
+                 "  noise: {full_well_e: 9000, read_noise_dn: 1.0}\n"
+                 "  jpeg: {quality: 70}\n");
+  const omnislam::degrade::DegradationConfig d = omnislam::io::load_config(file).degradation;
+  CHECK(d.seed == 42);
+  CHECK(d.center_u_px == 500.0);
+  CHECK(d.center_v_px == 510.5);
+  CHECK(d.exposure.enabled);
+  CHECK(d.exposure.max_change == 0.05);
+  CHECK_FALSE(d.vignetting.enabled);
+  CHECK(d.vignetting.rim_falloff == 0.2);
+  CHECK(d.vignetting.rim_radius_px == 480.0);
+  CHECK(d.dust.count == 3);
+  CHECK(d.dust.max_radius_px == 2.0);
+  CHECK(d.dust.min_opacity == 0.3);  // default kept
+  CHECK(d.dust.max_opacity == 0.5);
+  CHECK(d.blur.radius_px == 1.5);
+  CHECK(d.noise.full_well_e == 9000.0);
+  CHECK(d.noise.read_noise_dn == 1.0);
+  CHECK(d.jpeg.quality == 70);
+  CHECK(omnislam::io::load_config(write_file("no-degradation.yaml", "")).degradation.noise.full_well_e ==
+        6000.0);
+
+  const auto fails = [](const char *name, const char *text, const char *location, const char *message) {
+    CAPTURE(name);
+    CHECK_THROWS_WITH(omnislam::io::load_config(write_file(name, text)),
+                      Catch::Contains(location) && Catch::Contains(message));
+  };
+  fails("degradation-unknown.yaml", "degradation:\n  noise:\n    full_well: 5000\n",
+        "degradation-unknown.yaml:3:", "unknown key 'degradation.noise.full_well'");
+  fails("degradation-factor.yaml", "degradation:\n  smudge: {}\n",
+        "degradation-factor.yaml:2:", "unknown key 'degradation.smudge'");
+  fails("degradation-type.yaml", "degradation:\n  blur: {radius_px: wide}\n",
+        "degradation-type.yaml:2:", "'degradation.blur.radius_px' must be a number");
+  fails("degradation-range.yaml", "degradation:\n  jpeg:\n    quality: 101\n",
+        "degradation-range.yaml:3:", "'degradation.jpeg.quality' must be in 1..100");
+  fails("degradation-seed.yaml", "degradation:\n  seed: -1\n",
+        "degradation-seed.yaml:2:", "'degradation.seed' must be a non-negative integer");
+  fails("degradation-opacity.yaml", "degradation:\n  dust: {min_opacity: 0.8, max_opacity: 0.6}\n",
+        "degradation-opacity.yaml:2:", "'degradation.dust.max_opacity' must be in [0.8, 1]");
+  fails("degradation-exposure.yaml", "degradation:\n  exposure: {max_change: 1.0}\n",
+        "degradation-exposure.yaml:2:", "'degradation.exposure.max_change' must be in [0, 1)");
+  fails("degradation-enabled.yaml", "degradation:\n  noise: {enabled: maybe}\n",
+        "degradation-enabled.yaml:2:", "'degradation.noise.enabled' must be true or false");
+}
+
 TEST_CASE("config: the slam section, and the bundled thesis preset", "[io][config]") {
   const fs::path file =
       write_file("slam.yaml",

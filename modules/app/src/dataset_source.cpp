@@ -2,6 +2,7 @@
 
 #include <exception>
 #include <memory>
+#include <stdexcept>
 #include <utility>
 
 #include "omnislam/io/image_file.hpp"
@@ -23,6 +24,12 @@ pipeline::FrameSource dataset_source(const io::DatasetInfo &info, std::vector<Ei
     frame->has_odometry = true;
     try {
       frame->image = io::read_camera_image(info.image(frame_number), camera);
+      if (options.degrader) {
+        degrade::Degraded degraded = options.degrader->apply(frame->image, frame_number);
+        if (!degraded.ok())
+          throw std::runtime_error(info.image(frame_number).string() + ": " + degraded.error);
+        frame->image = std::move(degraded.image);
+      }
     } catch (const std::exception &error) {
       frame->error = error.what();
       if (options.on_skip) options.on_skip(frame_number, frame->error);

@@ -3,9 +3,11 @@
 #include <Eigen/Geometry>
 #include <functional>
 #include <limits>
+#include <memory>
 #include <string>
 #include <vector>
 
+#include "omnislam/degrade/degradation.hpp"
 #include "omnislam/io/dataset.hpp"
 #include "omnislam/pipeline/pipeline.hpp"
 
@@ -20,11 +22,14 @@ struct DatasetSourceOptions {
   /// Called (on the capture thread) for an image that cannot be used; the frame goes on
   /// as skipped, so SLAM still gets its odometry.
   std::function<void(int frame, const std::string &error)> on_skip;
+  /// When set, each image is degraded as its 1-based dataset frame number right after it is
+  /// read (so a degraded copy on disk and this give the same bytes).
+  std::shared_ptr<const degrade::Degrader> degrader;
 };
 
 /// Frame i (1-based) of the dataset: stamp (i - 1) / rate_hz, odometry[i - 1] (odometry
 /// poses of the dataset's frames, any fixed odom frame), the image read and checked
-/// against `camera`.
+/// against `camera`, then degraded when options.degrader is set.
 [[nodiscard]] pipeline::FrameSource dataset_source(const io::DatasetInfo &info,
                                                    std::vector<Eigen::Isometry2d> odometry,
                                                    const mirror::MirrorConfig &camera,

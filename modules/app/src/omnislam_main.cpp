@@ -2,6 +2,7 @@
 #include <cstdio>
 #include <exception>
 
+#include "degrade_command.hpp"
 #include "echo_command.hpp"
 #include "evaluate_command.hpp"
 #include "map_command.hpp"
@@ -18,6 +19,7 @@ int main(int argc, char **argv) {
   omnislam::app::add_scan_command(app);
   omnislam::app::add_replay_command(app);
   omnislam::app::add_evaluate_command(app);
+  omnislam::app::add_degrade_command(app);
   omnislam::app::add_map_command(app);
   omnislam::app::add_profile_command(app);
   omnislam::app::add_echo_command(app);

@@ -3,10 +3,12 @@
 #include <cstdio>
 #include <filesystem>
 #include <memory>
+#include <optional>
 #include <stdexcept>
 #include <string>
 
 #include "dataset_source.hpp"
+#include "degradation_options.hpp"
 #include "frame_record.hpp"
 #include "omnislam/io/config.hpp"
 #include "omnislam/io/dataset.hpp"
@@ -25,6 +27,8 @@ struct ReplayOptions {
   std::string odometry_file;
   std::string odometry_noise;
   std::uint64_t seed = 1;
+  std::string degrade = "none";
+  std::uint64_t degrade_seed = 1;
 };
 
 // Odometry as the robot reports it (the dataset's, or a given TUM or thesis-format file),
@@ -40,7 +44,7 @@ std::vector<Eigen::Isometry2d> load_odometry(const io::DatasetInfo &info, const 
                                            options.seed);
 }
 
-void run_replay(const ReplayOptions &options) {
+void run_replay(const ReplayOptions &options, std::optional<std::uint64_t> degrade_seed) {
   const io::DatasetInfo info = io::read_dataset_info(options.dataset);
   io::Config config = options.config_file.empty() ? io::Config{} : io::load_config(options.config_file);
   config.scan.camera = info.camera;  // the dataset describes its own camera and mirror
@@ -72,6 +76,14 @@ void run_replay(const ReplayOptions &options) {
       writer.write_thesis_map(static_cast<int>(frame.sequence), *frame.map);
   };
   DatasetSourceOptions source_options;
+  const degrade::DegradationConfig degradation =
+      degradation_for(config.degradation, options.degrade, degrade_seed);
+  run.degradation_factors = degrade::enabled_factors(degradation);
+  if (run.degradation_factors != "none") {
+    run.degradation_seed = degradation.seed;
+    source_options.degrader = std::make_shared<const degrade::Degrader>(
+        degradation, cv::Size(info.camera.image_width_px, info.camera.image_height_px));
+  }
   source_options.on_skip = [](int frame, const std::string &error) {
     std::fprintf(stderr, "omnislam replay: frame %d skipped: %s\n", frame, error.c_str());
   };
@@ -97,7 +109,17 @@ void add_replay_command(CLI::App &app) {
       ->check(CLI::IsMember({"thesis"}))
       ->excludes(odometry);
   command->add_option("--seed", options->seed, "seed of the odometry noise");
-  command->callback([options] { run_replay(*options); });
+  command
+      ->add_option("--degrade", options->degrade,
+                   "degrade the images as they are read: none, all, or a comma-separated list of "
+                   "exposure, vignetting, dust, blur, noise, jpeg (parameters: the config's degradation:)")
+      ->check(factor_list_validator())
+      ->capture_default_str();
+  auto *degrade_seed = command->add_option("--degrade-seed", options->degrade_seed,
+                                           "seed of the image degradation (default: the config's, 1)");
+  command->callback([options, degrade_seed] {
+    run_replay(*options, degrade_seed->count() > 0 ? std::optional(options->degrade_seed) : std::nullopt);
+  });
 }
 
 }  // namespace omnislam::app

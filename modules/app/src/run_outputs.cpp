@@ -196,6 +196,9 @@ void OutputWriter::write_all(const RunRecord &run, const slam::PointMap &map,
   const pipeline::DurationStats latency = pipeline::summarize(latency_ms);
   summary["latency_ms"] = {{"mean", latency.mean_ms}, {"p50", latency.p50_ms}, {"p99", latency.p99_ms}};
   summary["dropped"] = dropped;
+  if (run.degradation_factors != "none") {
+    summary["degradation"] = {{"factors", run.degradation_factors}, {"seed", run.degradation_seed}};
+  }
   if (run.ground_truth.size() == estimate.size() && !estimate.empty()) {
     const auto slam_error = slam::trajectory_error(estimate, run.ground_truth);
     const auto odometry_error = slam::trajectory_error(run.odometry_map, run.ground_truth);

@@ -2,6 +2,8 @@
 
 #include <Eigen/Geometry>
 #include <array>
+#include <cstdint>
+#include <string>
 #include <string_view>
 #include <vector>
 
@@ -37,6 +39,8 @@ struct RunRecord {
   std::vector<FrameRecord> frames;
   std::vector<Eigen::Isometry2d> ground_truth;  ///< map frame, empty when unknown
   std::vector<Eigen::Isometry2d> odometry_map;  ///< odometry in the map frame (first pose = identity)
+  std::string degradation_factors = "none";     ///< image degradation applied on the fly (replay --degrade)
+  std::uint64_t degradation_seed = 0;
 };
 
 }  // namespace omnislam::app

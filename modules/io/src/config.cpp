@@ -13,6 +13,8 @@ namespace detail {
 
 // omnislamd's sections (service_config.cpp).
 void read_service_sections(YamlSection &top, const std::string &file, ServiceConfig &service);
+// The image degradation (degradation_section.cpp).
+void read_degradation(YamlSection &section, const std::string &file, degrade::DegradationConfig &config);
 
 void read_camera_fields(YamlSection &section, mirror::MirrorConfig &camera) {
   section.read("width", camera.image_width_px);
@@ -217,6 +219,9 @@ Config load_config(const std::filesystem::path &file) {
     if (config.persistence.snapshot_period_s < 0.0) persistence.fail("snapshot_period_s", "must be >= 0");
     read_choice(persistence, "on_corrupt_snapshot", config.persistence.refuse_corrupt_snapshot,
                 {{"start_fresh", false}, {"refuse", true}}, "must be start_fresh or refuse");
+  });
+  read_section(top, "degradation", name, [&](YamlSection &degradation) {
+    detail::read_degradation(degradation, name, config.degradation);
   });
   detail::read_service_sections(top, name, config.service);
   top.finish();

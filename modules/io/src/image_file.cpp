@@ -29,4 +29,15 @@ cv::Mat read_camera_image(const std::filesystem::path &file, const mirror::Mirro
   return image;
 }
 
+void write_png_image(const std::filesystem::path &file, const cv::Mat &image) {
+  const std::string name = file.string();
+  bool written = false;
+  try {
+    written = cv::imwrite(name, image, {cv::IMWRITE_PNG_COMPRESSION, 3});
+  } catch (const cv::Exception &error) {
+    throw std::runtime_error(name + ": cannot write the PNG image: " + error.what());
+  }
+  if (!written) throw std::runtime_error(name + ": cannot write the PNG image");
+}
+
 }  // namespace omnislam::io

@@ -3,6 +3,7 @@
 #include <filesystem>
 #include <stdexcept>
 
+#include "omnislam/degrade/degradation_config.hpp"
 #include "omnislam/io/service_config.hpp"
 #include "omnislam/slam/slam.hpp"
 #include "omnislam/stereo/stereo_config.hpp"
@@ -29,10 +30,17 @@
 ///            use_odometry, no_odometry_min_srel_percent, no_odometry_max_rotation_deg, fusion_radius_m,
 ///            noise_radius_m, noise_min_neighbors, prune_every, prune_min_hits, prune_min_age,
 ///            localization_only}
+/// degradation: {seed, center_px: [u, v],
+///               exposure: {enabled, max_change}, vignetting: {enabled, rim_falloff, rim_radius_px},
+///               dust: {enabled, count, min_radius_px, max_radius_px, min_opacity, max_opacity,
+///                      inner_radius_px, outer_radius_px},
+///               blur: {enabled, radius_px}, noise: {enabled, full_well_e, read_noise_dn},
+///               jpeg: {enabled, quality}}
 /// persistence: {state_dir, resume, snapshot_period_s, on_corrupt_snapshot: start_fresh | refuse}
 /// input, pipeline, dds, service: omnislamd's sections (service_config.hpp)
 /// ```
-/// The field meanings are documented on the structs (vision_config.hpp, stereo_config.hpp, slam.hpp).
+/// The field meanings are documented on the structs (vision_config.hpp, stereo_config.hpp, slam.hpp,
+/// degrade/degradation_config.hpp).
 
 namespace omnislam::io {
 
@@ -58,6 +66,9 @@ struct Config {
   stereo::ScanConfig scan;
   slam::SlamConfig slam;
   PersistenceConfig persistence;
+  /// Image degradation: parameters of `omnislam degrade` and `replay --degrade`; which
+  /// factors run is chosen by those commands' factor list (degradation_config.hpp).
+  degrade::DegradationConfig degradation;
   ServiceConfig service;  ///< omnislamd: input, pipeline, dds, service (service_config.hpp)
 };
 
