@@ -124,8 +124,8 @@ void read_stereo(YamlSection &section, stereo::StereoConfig &stereo) {
     floor.read("error_rate", config.error_rate);
     floor.read("floor_plane_range", config.floor_plane_range);
     floor.finish();
-    if (config.max_edges_per_column < 1 || config.max_edges_per_column > 16)
-      floor.fail("max_edges_per_column", "must be 1..16");
+    if (config.max_edges_per_column < 1 || config.max_edges_per_column > 64)
+      floor.fail("max_edges_per_column", "must be 1..64");
     if (!(config.contact_margin_px > 0.0 && config.contact_margin_px <= 10.0))
       floor.fail("contact_margin_px", "must be in (0, 10]");
     if (!(config.error_rate > 0.0 && config.error_rate < 0.5)) floor.fail("error_rate", "must be in (0, 0.5)");

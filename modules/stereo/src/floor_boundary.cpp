@@ -37,7 +37,18 @@ float median_of(std::vector<float> &values) {
   return *middle;
 }
 
+// r_o^2 - r_i^2 in units of 512 px (the thesis image radius), the regressor of the gain.
+double radius_term(const FloorGeometry &geometry, int inner_row, float outer_row) {
+  const double inner = geometry.inner_radius_px(static_cast<float>(inner_row)) / 512.0;
+  const double outer = geometry.outer_radius_px(outer_row) / 512.0;
+  return outer * outer - inner * inner;
+}
+
 }  // namespace
+
+float FloorBoundaryFinder::gain(int inner_row, float outer_row) const {
+  return gain_at_centre_ + gain_slope_ * static_cast<float>(radius_term(*geometry_, inner_row, outer_row));
+}
 
 FloorBoundaryFinder::FloorBoundaryFinder(const FloorBoundaryConfig &config)
     : config_(config), decision_llr_(std::log((1.0 - config.error_rate) / config.error_rate)) {}
@@ -54,25 +65,40 @@ void FloorBoundaryFinder::prepare(const cv::Mat &inner_texture, const cv::Mat &o
   cv::GaussianBlur(inner_texture, inner_, cv::Size(5, 5), 1.0, 1.0, cv::BORDER_REPLICATE);
   cv::GaussianBlur(outer_texture, outer_, cv::Size(5, 5), 1.0, 1.0, cv::BORDER_REPLICATE);
   const int rows = inner_.rows, columns = inner_.cols;
-  gain_.assign(static_cast<std::size_t>(rows), 1.0f);
   floor_residual_.create(rows, columns, CV_32FC1);
   floor_residual_.setTo(kNaN);
-  // Per row, the brightness ratio of the two lobes on what the floor hypothesis pairs: the
-  // lobes differ by vignetting and mirror reflectance, both functions of the image radius.
-  for (int row = 0; row < rows; ++row) {
+  // The lobes differ in brightness by the mirror's reflectance and the lens's radial
+  // falloff (vignetting), both functions of the image radius. Fit the first-order model of
+  // gain() to the median brightness ratio of each row nearest the robot, where nearly
+  // every column sees floor and the floor hypothesis pairs the same point; rows higher up
+  // see walls, where that pairing is what is being tested and would bias the fit.
+  double sxx = 0.0, sx = 0.0, sy = 0.0, sxy = 0.0, n = 0.0;
+  for (int row = rows / 2; row < rows; ++row) {
     const float outer_row = geometry_->floor_outer_row(row);
-    float &gain = gain_[static_cast<std::size_t>(row)];
-    gain = 1.0f;
     if (!std::isfinite(outer_row)) continue;
     ratios_.clear();
     for (int column = 0; column < columns; ++column) {
       const float inner = inner_.at<float>(row, column), outer = outer_at(outer_row, column);
       if (inner > kDarkLevel && outer > kDarkLevel) ratios_.push_back(inner / outer);
     }
-    if (ratios_.size() * 10 >= static_cast<std::size_t>(columns)) gain = median_of(ratios_);
+    if (ratios_.size() * 2 < static_cast<std::size_t>(columns)) continue;
+    const double x = radius_term(*geometry_, row, outer_row), y = median_of(ratios_);
+    sxx += x * x, sx += x, sy += y, sxy += x * y, n += 1.0;
+  }
+  const double determinant = n * sxx - sx * sx;
+  gain_at_centre_ = 1.0f, gain_slope_ = 0.0f;
+  if (n >= 8.0 && determinant > 1e-12) {
+    gain_slope_ = static_cast<float>((n * sxy - sx * sy) / determinant);
+    gain_at_centre_ = static_cast<float>((sy - gain_slope_ * sx) / n);
+  } else if (n >= 1.0) {
+    gain_at_centre_ = static_cast<float>(sy / n);
+  }
+  for (int row = 0; row < rows; ++row) {
+    const float outer_row = geometry_->floor_outer_row(row);
+    if (!std::isfinite(outer_row)) continue;
+    const float g = gain(row, outer_row);
     for (int column = 0; column < columns; ++column) {
-      floor_residual_.at<float>(row, column) =
-          std::abs(inner_.at<float>(row, column) - gain * outer_at(outer_row, column));
+      floor_residual_.at<float>(row, column) = std::abs(inner_.at<float>(row, column) - g * outer_at(outer_row, column));
     }
   }
   // Noise scale from the rows nearest the robot, mostly floor in any room: a Laplace
@@ -98,25 +124,25 @@ float FloorBoundaryFinder::window_cost(int inner_row, float outer_row, int colum
     for (int dr = -window.half_window_rows; dr <= window.half_window_rows; ++dr) {
       const int row = std::clamp(inner_row + dr, 0, rows - 1);
       sum += std::abs(inner_.at<float>(row, col) -
-                      gain_[static_cast<std::size_t>(row)] * outer_at(outer_row + static_cast<float>(dr), col));
+                      gain(row, outer_row + static_cast<float>(dr)) * outer_at(outer_row + static_cast<float>(dr), col));
     }
   }
   return sum;
 }
 
-FloorBoundaryFinder::Verdict FloorBoundaryFinder::floor_or_vertical(int column, float edge_row) const {
-  // Wald's sequential test, rows outwards from the edge. Both hypotheses pass through the
-  // edge's base, so near it they predict nearly the same outer row, and there the residuals
-  // measure only the sub-pixel placement of a steep edge, not the hypotheses: a row votes
-  // once the two predictions are a pixel apart (and outside the edge's own blur).
+FloorBoundaryFinder::Verdict FloorBoundaryFinder::floor_or_vertical(int column, float edge_row,
+                                                                     float contact_row) const {
+  // Wald's sequential test, rows outwards from the edge. Rows inside the edge's own blur,
+  // in either lobe, measure the sub-pixel placement of a steep edge rather than the
+  // hypotheses, and do not vote.
   double llr = 0.0;
   for (int row = static_cast<int>(edge_row) - kEdgeBlurRows; row >= 0; --row) {
     const float floor_residual = floor_residual_.at<float>(row, column);
     const float vertical_row = geometry_->vertical_outer_row_at(row, edge_row);
     if (!std::isfinite(floor_residual) || !std::isfinite(vertical_row)) continue;
-    if (std::abs(vertical_row - geometry_->floor_outer_row(row)) < 1.0f) continue;
+    if (std::abs(vertical_row - contact_row) <= kEdgeBlurRows) continue;
     const float vertical_residual =
-        std::abs(inner_.at<float>(row, column) - gain_[static_cast<std::size_t>(row)] * outer_at(vertical_row, column));
+        std::abs(inner_.at<float>(row, column) - gain(row, vertical_row) * outer_at(vertical_row, column));
     // Laplace log-likelihood ratio of the row, less a dead zone of half the scale: what the
     // model itself leaves (sub-pixel base, interpolation, the gain estimate) must not add up
     // over a long uniform wall as if it were evidence.
@@ -200,7 +226,7 @@ BoundaryStats FloorBoundaryFinder::find(const FloorGeometry &geometry, const cv:
       }
       // 3. On the floor: floor going on, or a vertical surface standing here?
       const float outer_row = contact != nullptr ? contact->row_subpx : floor_row;
-      const Verdict verdict = floor_or_vertical(column, edge.row_subpx);
+      const Verdict verdict = floor_or_vertical(column, edge.row_subpx, outer_row);
       const auto range_m = static_cast<float>(geometry_->floor_range_at(edge.row_subpx));
       if (verdict == Verdict::kFloor) {
         ++stats.floor_texture;

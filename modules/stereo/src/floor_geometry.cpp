@@ -15,7 +15,11 @@ float row_or_nan(const std::optional<double> &row) { return row ? static_cast<fl
 }  // namespace
 
 FloorGeometry::FloorGeometry(const mirror::MirrorModel &model, double camera_height_m)
-    : model_(model), camera_height_m_(camera_height_m), rows_(model.config().rows_per_lobe) {
+    : model_(model),
+      camera_height_m_(camera_height_m),
+      rows_(model.config().rows_per_lobe),
+      inner_radius_offset_px_(static_cast<float>(model.radius_px_of_row(mirror::Lobe::kInner, 0.0))),
+      outer_radius_offset_px_(static_cast<float>(model.radius_px_of_row(mirror::Lobe::kOuter, 0.0))) {
   using mirror::Lobe;
   const auto rows = static_cast<std::size_t>(rows_);
   floor_range_m_.assign(rows, kNaN);

@@ -77,7 +77,7 @@ class FloorBoundaryFinder {
   void prepare(const cv::Mat &inner_texture, const cv::Mat &outer_texture);
   /// Log-likelihood ratio, floor over vertical surface, of the rows above `edge_row`.
   enum class Verdict { kFloor, kVertical, kUndecided };
-  [[nodiscard]] Verdict floor_or_vertical(int column, float edge_row) const;
+  [[nodiscard]] Verdict floor_or_vertical(int column, float edge_row, float contact_row) const;
   [[nodiscard]] float outer_at(float row, int column) const;
   /// Gain-compensated SAD of the inner window at `inner_row` and the outer one at
   /// `outer_row` (fractional), on the smoothed textures.
@@ -90,7 +90,12 @@ class FloorBoundaryFinder {
   cv::Mat inner_;           ///< smoothed inner texture
   cv::Mat outer_;           ///< smoothed outer texture
   cv::Mat floor_residual_;  ///< |inner - gain * outer at the floor row|, per inner row and column
-  std::vector<float> gain_;  ///< per inner row: inner / outer brightness of the same floor point
+  /// Brightness of the inner lobe over the outer lobe for the same scene point, seen at
+  /// image radii r_i and r_o: reflectance ratio times radial falloff to first order,
+  /// gain_at_centre_ + gain_slope_ * (r_o^2 - r_i^2) (radii in units of 512 px).
+  [[nodiscard]] float gain(int inner_row, float outer_row) const;
+  float gain_at_centre_ = 1.0f;
+  float gain_slope_ = 0.0f;
   std::vector<float> ratios_;
   float noise_scale_ = 0.0f;
 };

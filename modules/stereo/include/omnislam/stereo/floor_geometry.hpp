@@ -38,6 +38,9 @@ class FloorGeometry {
   [[nodiscard]] float vertical_outer_row(int row, int base_row) const {
     return vertical_outer_row_[index(base_row) * static_cast<std::size_t>(rows_) + index(row)];
   }
+  /// Image radius (px) of a panorama row of each lobe (mirror.md sec. 0).
+  [[nodiscard]] float inner_radius_px(float row) const { return inner_radius_offset_px_ - row; }
+  [[nodiscard]] float outer_radius_px(float row) const { return outer_radius_offset_px_ - row; }
   /// The same for a fractional base row (linear between the two base rows around it).
   [[nodiscard]] float vertical_outer_row_at(int row, float base_row) const;
 
@@ -47,6 +50,8 @@ class FloorGeometry {
   mirror::MirrorModel model_;
   double camera_height_m_ = 0.0;
   int rows_ = 0;
+  float inner_radius_offset_px_ = 0.0f;
+  float outer_radius_offset_px_ = 0.0f;
   std::vector<float> floor_range_m_;
   std::vector<float> floor_outer_row_;
   std::vector<float> vertical_outer_row_;  ///< [base_row][row]

@@ -31,8 +31,9 @@ enum class BoundaryMethod {
 
 /// The floor-boundary search (floor_boundary.hpp).
 struct FloorBoundaryConfig {
-  /// Horizontal edges examined per column, nearest first (a tiled floor has many).
-  int max_edges_per_column = 16;
+  /// Horizontal edges examined per column, nearest first: a tiled floor gives two per grout
+  /// line, so 400 mm tiles put ~10 between the robot and a wall 2 m away, more with shadows.
+  int max_edges_per_column = 32;
   /// An edge is on the floor when the outer lobe has an edge of the same polarity within
   /// this many pixels of the row the floor predicts: the sub-pixel edge error of both lobes
   /// (~0.2 px each) plus what a calibrated rig leaves (~0.5 px), with room to spare.
