@@ -15,8 +15,8 @@ import yaml
 from conftest import DATASET_NAMES, REPO, SCRIPTS
 from helpers import angle_diff, floor_wall_edge_errors, poses, steps, table_mm, times
 
-from omnislam_render import convention, datasets, geocheck, mirror, odometry
-from omnislam_render.pngio import read_png
+from omnislam_render import convention, datasets, geocheck, mirror, odometry, rooms
+from omnislam_render.pngio import read_png, to_gray, write_png_gray
 
 RENDER = [sys.executable, str(SCRIPTS / "render-dataset")]
 
@@ -27,9 +27,24 @@ EXPECTED_POINTS = {
     "sim-room-turning": table_mm("3.2"),
     "l-room-1lap": table_mm("3.3") + table_mm("3.3")[:1],
     "l-room-2laps": table_mm("3.3") * 2 + table_mm("3.3")[:1],
+    # realistic looks of the same geometry: the same poses as their flat twins
+    "sim-room-37-real": table_mm("3.2"),
+    "l-room-1lap-real": table_mm("3.3") + table_mm("3.3")[:1],
+    # no table: the office loop is checked by test_office_loop_circles_the_pillar
+    "office-real": [(x * 1000.0, y * 1000.0) for x, y, _ in datasets.office_loop()],
 }
 EXPECTED_FRAMES = {"sim-room-10": 10, "sim-room-37": 37, "sim-room-turning": 37,
-                   "l-room-1lap": 60, "l-room-2laps": 119}
+                   "l-room-1lap": 60, "l-room-2laps": 119,
+                   "sim-room-37-real": 37, "l-room-1lap-real": 60, "office-real": 45}
+# Datasets facing the direction of travel (heading not constant): no thesis odometry.txt.
+TURNING = {"sim-room-turning", "office-real"}
+CAMERA_HEIGHT_M = {"office-real": 0.8}      # the others 1.0
+# Realistic datasets (rooms_real.py), their flat twin (same geometry) and the floor pattern.
+REALISTIC = {"sim-room-37-real": ("sim-room-37", "cells"), "l-room-1lap-real": ("l-room-1lap", "brick"),
+             "office-real": (None, "hexagon")}
+SKIRTING_DEPTH_M = 0.012
+METADATA_FILES = ["groundtruth.tum", "odometry.tum", "odometry_exact.tum", "odometry.txt", "floorplan.csv",
+                  "dataset.yaml"]
 
 
 # ---------------------------------------------------------------------------- metadata
@@ -42,7 +57,7 @@ def test_dataset_yaml_keys(metadata_dir, name):
     assert meta["camera"] == {"width": 1024, "height": 1024, "center_px": [511.5, 511.5],
                               "focal_mm": 25.0, "pixel_pitch_mm": pytest.approx(0.00702051, abs=1e-8)}
     assert meta["mirror"] == "thesis-2008"
-    assert meta["camera_height_m"] == 1.0
+    assert meta["camera_height_m"] == CAMERA_HEIGHT_M.get(name, 1.0)
     assert meta["frames"] == EXPECTED_FRAMES[name]
     assert meta["rate_hz"] == 10
     assert meta["images"] == "images/%06d.png"
@@ -59,32 +74,57 @@ def test_groundtruth_reproduces_trajectory_table(metadata_dir, name):
     assert times(metadata_dir / name / "groundtruth.tum") == pytest.approx([i / 10 for i in range(len(gt))])
     # Map frame = first pose: for a constant heading the table relative to point 1;
     # when turning, also rotated by the first heading (towards point 2).
+    assert datasets.DATASETS[name].constant_heading == (name not in TURNING)
     yaw0 = 0.0
-    if name == "sim-room-turning":
+    if name in TURNING:
         yaw0 = math.atan2(pts[1][1] - pts[0][1], pts[1][0] - pts[0][0])
     c, s = math.cos(yaw0), math.sin(yaw0)
     for (x, y, yaw), (px, py) in zip(gt, pts):
         dx, dy = (px - pts[0][0]) / 1000.0, (py - pts[0][1]) / 1000.0
         assert x == pytest.approx(c * dx + s * dy, abs=1e-9)
         assert y == pytest.approx(-s * dx + c * dy, abs=1e-9)
-        if name != "sim-room-turning":
+        if name not in TURNING:
             assert abs(yaw) < 1e-12
 
 
-def test_turning_headings_face_travel_and_turn_smoothly(metadata_dir):
-    gt = poses(metadata_dir / "sim-room-turning" / "groundtruth.tum")
+@pytest.mark.parametrize("name, corners, min_facing", [("sim-room-turning", 4, 20), ("office-real", 3, 30)])
+def test_turning_headings_face_travel_and_turn_smoothly(metadata_dir, name, corners, min_facing):
+    gt = poses(metadata_dir / name / "groundtruth.tum")
     yaw_steps = [abs(angle_diff(b[2], a[2])) for a, b in zip(gt[:-1], gt[1:])]
     # The sharpest turn (90 deg) is spread over several poses.
     assert max(yaw_steps) <= math.radians(90.0 / 4) + 1e-9
     turning = [i for i, d in enumerate(yaw_steps) if d > 1e-9]
-    assert len(turning) >= 12            # 4 corners x >= 3 steps
+    assert len(turning) >= 3 * corners   # corners x >= 3 steps
     # On the straight parts the robot faces its direction of travel.
     facing = 0
     for a, b in zip(gt[:-1], gt[1:]):
         travel = math.atan2(b[1] - a[1], b[0] - a[0])
         if abs(angle_diff(a[2], travel)) < 1e-9 and abs(angle_diff(b[2], travel)) < 1e-9:
             facing += 1
-    assert facing >= 20
+    assert facing >= min_facing
+
+
+def test_office_loop_circles_the_pillar():
+    """office-real: one counter-clockwise lap around the pillar back to the start, steps of
+    0.25-0.30 m, first and last pose facing their step, left turns only (three corners of
+    90 deg; the fourth is where the lap starts and ends)."""
+    spec = datasets.DATASETS["office-real"]
+    world = spec.world_poses()
+    assert len(world) == 45
+    assert world[0][:2] == world[-1][:2]
+    lengths = [math.hypot(b[0] - a[0], b[1] - a[1]) for a, b in zip(world[:-1], world[1:])]
+    assert min(lengths) >= 0.25 and max(lengths) <= 0.30
+    assert sum(lengths) == pytest.approx(2 * (4.6 + 1.6), abs=1e-5)
+    pillar = next(o for o in spec.room().objects if o.name == "pillar")
+    cx, cy = pillar.centre
+    bearings = [math.atan2(p[1] - cy, p[0] - cx) for p in world]
+    winding = sum(angle_diff(b, a) for a, b in zip(bearings[:-1], bearings[1:]))
+    assert winding == pytest.approx(2 * math.pi, abs=1e-9)
+    for pose, (a, b) in ((world[0], (world[0], world[1])), (world[-1], (world[-2], world[-1]))):
+        assert angle_diff(pose[2], math.atan2(b[1] - a[1], b[0] - a[0])) == pytest.approx(0.0, abs=1e-9)
+    turns = [angle_diff(b[2], a[2]) for a, b in zip(world[:-1], world[1:])]
+    assert min(turns) >= -1e-12
+    assert sum(turns) == pytest.approx(math.radians(270.0), abs=1e-9)
 
 
 @pytest.mark.parametrize("name", DATASET_NAMES)
@@ -156,7 +196,7 @@ def test_noisy_odometry_reproducible_and_seeded(metadata_dir, tmp_path):
 @pytest.mark.parametrize("name", DATASET_NAMES)
 def test_thesis_odometry_txt_matches_tum(metadata_dir, name):
     path = metadata_dir / name / "odometry.txt"
-    if name == "sim-room-turning":
+    if name in TURNING:
         assert not path.exists()          # heading not constant: no thesis-format file
         return
     pairs = odometry.read_thesis_odometry(path)
@@ -198,6 +238,65 @@ def test_floorplan_l_room(metadata_dir):
     assert len(segs) == 6 + 3 * 5 * 4 + 2 * 4   # walls, three 4-legged tables, cabinet, crate
 
 
+def _inset_walls(walls: np.ndarray, depth: float) -> np.ndarray:
+    """The walls of an axis-aligned counter-clockwise polygon moved inwards by `depth`:
+    each corner moves by `depth` along the inward normals of both walls meeting there
+    (where the two moved walls, perpendicular, meet again)."""
+    d = walls[:, 2:] - walls[:, :2]
+    d /= np.hypot(d[:, 0], d[:, 1])[:, None]
+    assert np.all(np.abs(d[:, 0] * np.roll(d, 1, axis=0)[:, 0] + d[:, 1] * np.roll(d, 1, axis=0)[:, 1]) < 1e-12)
+    inward = np.stack([-d[:, 1], d[:, 0]], axis=1)          # left of a counter-clockwise wall
+    corners = walls[:, :2] + depth * (inward + np.roll(inward, 1, axis=0))
+    return np.hstack([corners, np.roll(corners, -1, axis=0)])
+
+
+@pytest.mark.parametrize("name, n_walls", [("sim-room-37-real", 4), ("l-room-1lap-real", 6)])
+def test_floorplan_realistic_twin_is_flat_plan_with_skirting(metadata_dir, name, n_walls):
+    """Same objects as the flat twin; the walls are the skirting boards' faces, 12 mm inside."""
+    twin = REALISTIC[name][0]
+    real_lines = (metadata_dir / name / "floorplan.csv").read_text().splitlines()
+    flat_lines = (metadata_dir / twin / "floorplan.csv").read_text().splitlines()
+    assert len(real_lines) == len(flat_lines)
+    assert real_lines[1 + n_walls:] == flat_lines[1 + n_walls:]
+    segs, flat = _floorplan(metadata_dir / name / "floorplan.csv"), _floorplan(metadata_dir / twin / "floorplan.csv")
+    assert segs[:n_walls] == pytest.approx(_inset_walls(flat[:n_walls], SKIRTING_DEPTH_M), abs=2e-9)
+    # the same in the room frame, unrounded
+    room, flat_room = datasets.DATASETS[name].room(), datasets.DATASETS[twin].room()
+    assert room.floorplan()[n_walls:] == flat_room.floorplan()[n_walls:]
+    expected = _inset_walls(np.array(flat_room.floorplan()[:n_walls]), SKIRTING_DEPTH_M)
+    assert np.array(room.floorplan()[:n_walls]) == pytest.approx(expected, abs=1e-12)
+    if name == "sim-room-37-real":
+        xs, ys = segs[:4, [0, 2]], segs[:4, [1, 3]]
+        assert xs.min() == pytest.approx(-7.0 + 0.012) and xs.max() == pytest.approx(1.0 - 0.012)
+        assert ys.min() == pytest.approx(-3.5 + 0.012) and ys.max() == pytest.approx(0.5 - 0.012)
+
+
+def test_floorplan_office(metadata_dir):
+    segs = _floorplan(metadata_dir / "office-real" / "floorplan.csv")
+    # map frame = pose 1 at room (1.2, 1.8), heading 0: the 7.0 x 5.2 m room's walls
+    # x = 0, 7 and y = 0, 5.2, at the skirting faces 12 mm inside
+    ox, oy, d = 1.2, 1.8, SKIRTING_DEPTH_M
+    expected_walls = [(-ox + d, -oy + d, 7.0 - ox - d, -oy + d), (7.0 - ox - d, -oy + d, 7.0 - ox - d, 5.2 - oy - d),
+                      (7.0 - ox - d, 5.2 - oy - d, -ox + d, 5.2 - oy - d), (-ox + d, 5.2 - oy - d, -ox + d, -oy + d)]
+    assert segs[:4] == pytest.approx(np.array(expected_walls), abs=2e-9)
+    # 4 walls + pillar (24) + desk top and 4 legs + sofa + bookshelf + low table top and
+    # 4 legs (4 sides each) + bin (24)
+    assert len(segs) == 4 + 24 + 4 * 12 + 24
+    for circle, (cx, cy), r in ((segs[4:28], (3.5, 2.6), 0.2), (segs[-24:], (0.4, 0.4), 0.15)):
+        assert np.hypot(circle[:, 0] - (cx - ox), circle[:, 1] - (cy - oy)) == pytest.approx(np.full(24, r), abs=2e-9)
+        assert np.array_equal(circle[:, 2:], np.roll(circle[:, :2], -1, axis=0))     # closed 24-gon
+    boxes = [(0.4, 3.9, 2.0, 4.7),                                                    # desk top
+             *[(x, y, x + 0.05, y + 0.05) for x, y in ((0.45, 3.95), (1.9, 3.95), (1.9, 4.6), (0.45, 4.6))],
+             (4.5, 0.3, 6.5, 1.2),                                                    # sofa
+             (6.65, 2.0, 7.0, 3.2),                                                   # bookshelf
+             (4.4, 4.0, 5.2, 4.6),                                                    # low table top
+             *[(x, y, x + 0.05, y + 0.05) for x, y in ((4.45, 4.05), (5.1, 4.05), (5.1, 4.5), (4.45, 4.5))]]
+    for k, (x0, y0, x1, y1) in enumerate(boxes):
+        x0, y0, x1, y1 = x0 - ox, y0 - oy, x1 - ox, y1 - oy
+        rect = [(x0, y0, x1, y0), (x1, y0, x1, y1), (x1, y1, x0, y1), (x0, y1, x0, y0)]
+        assert segs[28 + 4 * k:32 + 4 * k] == pytest.approx(np.array(rect), abs=2e-9), f"box {k}"
+
+
 def test_frames_option_limits_metadata(tmp_path):
     out = tmp_path / "ds"
     subprocess.run(RENDER + ["l-room-2laps", "--out", str(out), "--frames", "7", "--no-images"],
@@ -210,7 +309,71 @@ def test_frames_option_limits_metadata(tmp_path):
     assert not (out / "images").exists()
 
 
+@pytest.mark.parametrize("name", DATASET_NAMES)
+def test_bundled_metadata_is_reproduced(metadata_dir, name):
+    """The metadata of every bundled dataset (datasets/<name>) is what build() writes, byte for byte."""
+    bundled = REPO / "datasets" / name
+    if not (bundled / "dataset.yaml").is_file():
+        pytest.skip(f"{name} is not bundled (no datasets/{name}/dataset.yaml)")
+    for f in METADATA_FILES:
+        built = metadata_dir / name / f
+        assert built.is_file() == (bundled / f).is_file(), f
+        if built.is_file():
+            assert built.read_bytes() == (bundled / f).read_bytes(), f
+
+
+# ---------------------------------------------------------------------------- grey PNGs
+@pytest.mark.parametrize("shape", [(1024, 1024), (3, 5)])
+def test_write_png_gray_round_trips(tmp_path, shape):
+    img = np.random.default_rng(7).integers(0, 256, size=shape, dtype=np.uint8)
+    write_png_gray(tmp_path / "grey.png", img)
+    back = read_png(tmp_path / "grey.png")
+    assert back.dtype == np.uint8 and back.shape == shape
+    assert np.array_equal(back, img)
+
+
+def test_to_gray_weights():
+    rgb = np.array([[[255, 0, 0], [0, 255, 0], [0, 0, 255], [255, 255, 255], [0, 0, 0]]], np.uint8)
+    grey = to_gray(rgb)
+    assert grey.dtype == np.uint8 and grey.shape == (1, 5)
+    assert grey.tolist() == [[76, 150, 29, 255, 0]]
+    # an alpha channel is ignored, a grey image is kept
+    rgba = np.concatenate([rgb, np.full((1, 5, 1), 7, np.uint8)], axis=2)
+    assert np.array_equal(to_gray(rgba), grey)
+    assert np.array_equal(to_gray(grey), grey)
+
+
 # ---------------------------------------------------------------------------- rendering
+@pytest.mark.parametrize("name", sorted(REALISTIC))
+def test_realistic_room_scene_parts(name):
+    """(Rendering one realistic frame is too slow for the suite: check the scene text.)"""
+    spec = datasets.DATASETS[name]
+    assert spec.grey
+    room = spec.room()
+    body = room.pov_body()
+    assert room.floor_texture and REALISTIC[name][1] in room.floor_texture
+    assert f"plane {{ z, 0 {room.floor_texture} }}  // floor" in body
+    assert body.count("area_light") == len(room.area_lamps) >= 2
+    assert body.count("projected_through") == 1 and "// sun through window" in body
+    assert body.count("// skirting") == len(room.outline)
+    assert "shadowless" not in body
+
+
+@pytest.mark.parametrize("name", [n for n in DATASET_NAMES if n not in REALISTIC])
+def test_flat_rooms_have_no_realistic_parts(name):
+    spec = datasets.DATASETS[name]
+    assert not spec.grey
+    body = spec.room().pov_body()
+    for part in ("area_light", "projected_through", "// skirting", "texture", "no_shadow"):
+        assert part not in body
+
+
+def test_flat_scene_keys_unchanged():
+    # the keys the bundled flat datasets record (their images stay valid)
+    assert datasets.render_key(rooms.sim_room()) == "f27652dab1e05c78"
+    assert datasets.render_key(rooms.l_room()) == "df606803c84301d3"
+
+
 def test_convention_check_matches_reference(tmp_path):
     png = tmp_path / "convention.png"
     convention.render_convention(png)
