@@ -37,7 +37,13 @@ TEST_CASE("config: every section read on top of the defaults", "[io][config]") {
                                    "  occlusion_cost: 3.0\n"
                                    "  subpixel: cost_curve\n"
                                    "  triangulation: table\n"
-                                   "  far_cutoff_m: 2.0\n");
+                                   "  far_cutoff_m: 2.0\n"
+                                   "  boundary: nearest_edge\n"
+                                   "  floor:\n"
+                                   "    max_edges_per_column: 20\n"
+                                   "    contact_margin_px: 2.0\n"
+                                   "    error_rate: 0.05\n"
+                                   "    floor_plane_range: false\n");
   const omnislam::io::Config config = omnislam::io::load_config(file);
   const auto &scan = config.scan;
   CHECK(scan.camera.image_width_px == 800);
@@ -56,6 +62,11 @@ TEST_CASE("config: every section read on top of the defaults", "[io][config]") {
   CHECK(scan.stereo.subpixel == omnislam::stereo::SubpixelMethod::kCostCurve);
   CHECK(scan.stereo.triangulation == omnislam::stereo::TriangulationMethod::kTable);
   CHECK(scan.stereo.far_cutoff_m == 2.0);
+  CHECK(scan.stereo.boundary == omnislam::stereo::BoundaryMethod::kNearestEdge);
+  CHECK(scan.stereo.floor.max_edges_per_column == 20);
+  CHECK(scan.stereo.floor.contact_margin_px == 2.0);
+  CHECK(scan.stereo.floor.error_rate == 0.05);
+  CHECK_FALSE(scan.stereo.floor.floor_plane_range);
   CHECK(scan.stereo.near_cutoff_m == 0.3);
 }
 
@@ -79,6 +90,14 @@ TEST_CASE("config: unknown keys and wrong types name the key and file:line", "[i
   const fs::path integer = write_file("integer.yaml", "vision:\n  max_edges_per_column: 2.5\n");
   CHECK_THROWS_WITH(omnislam::io::load_config(integer),
                     Catch::Contains("integer.yaml:2:") && Catch::Contains("must be an integer"));
+  const fs::path floor = write_file("floor.yaml", "stereo:\n  floor:\n    error_rate: 0.7\n");
+  CHECK_THROWS_WITH(omnislam::io::load_config(floor), Catch::Contains("'stereo.floor.error_rate'"));
+  const fs::path floor_key = write_file("floor_key.yaml", "stereo:\n  floor:\n    margin: 1\n");
+  CHECK_THROWS_WITH(omnislam::io::load_config(floor_key),
+                    Catch::Contains("floor_key.yaml:3:") && Catch::Contains("'stereo.floor.margin'"));
+  const fs::path boundary = write_file("boundary.yaml", "stereo:\n  boundary: widest\n");
+  CHECK_THROWS_WITH(omnislam::io::load_config(boundary),
+                    Catch::Contains("boundary.yaml:2:") && Catch::Contains("floor_boundary or nearest_edge"));
   const fs::path choice = write_file("choice.yaml", "stereo:\n  subpixel: magic\n");
   CHECK_THROWS_WITH(omnislam::io::load_config(choice),
                     Catch::Contains("choice.yaml:2:") && Catch::Contains("none, edge_peak or cost_curve"));

@@ -22,7 +22,9 @@
 ///            min_relative_contrast, half_window_rows, half_window_columns}
 /// stereo:   {min_range_m, max_range_m, disparity_margin_px, occlusion_cost,
 ///            subpixel: none | edge_peak | cost_curve, triangulation: exact | table,
-///            near_cutoff_m, far_cutoff_m, one_point_per_degree}
+///            near_cutoff_m, far_cutoff_m, one_point_per_degree,
+///            boundary: floor_boundary | nearest_edge,
+///            floor: {max_edges_per_column, contact_margin_px, error_rate, floor_plane_range}}
 /// slam:     {target: map | previous_scan, metric: point_to_line | point_to_point, overlap,
 ///            initial_search_radius_m, max_iterations, estimate_scale, keep_global_minimum,
 ///            use_srel_test, srel_limit_percent, srel_relax_percent, optional_map_correction,

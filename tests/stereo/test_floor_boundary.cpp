@@ -1,0 +1,87 @@
+#include <catch2/catch.hpp>
+#include <cmath>
+#include <opencv2/imgcodecs.hpp>
+
+#include "omnislam/mirror/mirror_model.hpp"
+#include "omnislam/stereo/floor_geometry.hpp"
+#include "omnislam/stereo/scan_reconstructor.hpp"
+
+using omnislam::mirror::Lobe;
+using omnislam::mirror::MirrorModel;
+using omnislam::stereo::FloorGeometry;
+
+TEST_CASE("floor geometry: the outer row of every floor point agrees with the mirror model",
+          "[stereo][floor]") {
+  const MirrorModel model;
+  for (const double height_m : {0.8, 1.0, 1.3}) {
+    const FloorGeometry geometry(model, height_m);
+    int seen = 0;
+    for (int row = 0; row < geometry.rows(); ++row) {
+      const float range_m = geometry.floor_range_m(row);
+      if (!std::isfinite(range_m)) continue;
+      // The inner lobe sees the floor point at this very row.
+      const auto inner = model.project_row(Lobe::kInner, {range_m, -height_m});
+      REQUIRE(inner);
+      CHECK(*inner == Approx(row).margin(1e-4));
+      const auto outer = model.project_row(Lobe::kOuter, {range_m, -height_m});
+      if (!outer) continue;
+      ++seen;
+      CHECK(geometry.floor_outer_row(row) == Approx(*outer).margin(1e-4));
+      // Triangulating the pair returns the floor point.
+      const auto point = model.triangulate_rows(row, geometry.floor_outer_row(row));
+      REQUIRE(point);
+      CHECK(point->height_m == Approx(-height_m).margin(1e-3));
+    }
+    CHECK(seen > 150);
+  }
+}
+
+TEST_CASE("floor geometry: a vertical surface on the floor is seen at its base's range", "[stereo][floor]") {
+  const MirrorModel model;
+  const FloorGeometry geometry(model, 1.0);
+  int checked = 0;
+  for (int base = 60; base < 220; base += 20) {
+    const double wall_m = geometry.floor_range_m(base);
+    for (int row = base - 40; row < base; row += 5) {
+      const float outer = geometry.vertical_outer_row(row, base);
+      if (!std::isfinite(outer)) continue;
+      const auto point = model.triangulate_rows(row, outer);
+      REQUIRE(point);
+      CHECK(point->range_m == Approx(wall_m).epsilon(1e-4));
+      CHECK(point->height_m > -1.0);  // above the floor
+      ++checked;
+    }
+    // Undefined at or below the base row.
+    CHECK(std::isnan(geometry.vertical_outer_row(base, base)));
+  }
+  CHECK(checked > 40);
+}
+
+TEST_CASE("floor boundary on the convention image: one point per column at most, free ranges",
+          "[stereo][floor]") {
+  const cv::Mat image = cv::imread(OMNISLAM_CONVENTION_IMAGE, cv::IMREAD_GRAYSCALE);
+  REQUIRE_FALSE(image.empty());
+  omnislam::stereo::ScanReconstructor reconstructor;
+  const omnislam::stereo::LocalScan scan = reconstructor.reconstruct(image);
+  REQUIRE(scan.status == omnislam::stereo::ScanStatus::kOk);
+  REQUIRE(scan.free_range_m.size() == 360u);
+  CHECK(scan.points.size() > 100u);
+  CHECK(scan.points.size() <= 360u);
+  int known = 0;
+  for (const auto &point : scan.points) {
+    const auto column = static_cast<std::size_t>(point.azimuth_rad * 180.0 / M_PI);
+    const float free_m = scan.free_range_m[column];
+    REQUIRE(std::isfinite(free_m));
+    CHECK(free_m <= point.range_m + 1e-6);  // the floor is never free beyond the boundary
+    ++known;
+  }
+  CHECK(known == static_cast<int>(scan.points.size()));
+
+  // The thesis's selection stays available and gives no free ranges.
+  omnislam::stereo::ScanConfig thesis;
+  thesis.stereo.boundary = omnislam::stereo::BoundaryMethod::kNearestEdge;
+  omnislam::stereo::ScanReconstructor nearest(thesis);
+  const omnislam::stereo::LocalScan nearest_scan = nearest.reconstruct(image);
+  CHECK(nearest_scan.free_range_m.empty());
+  CHECK(nearest_scan.points.size() > 100u);
+}
