@@ -20,7 +20,7 @@ constexpr float kDarkLevel = 0.02f;
 // and halved: the residuals of neighbouring rows share the 5x5 smoothing.
 constexpr float kMaxRowVote = 3.0f;
 constexpr float kRowCorrelation = 0.5f;
-constexpr float kDeadZone = 0.5f;
+constexpr float kDeadZone = 2.0f;  // in units of the residual scale
 // The 7 x 3 similarity window's pixels share the smoothing in both directions.
 constexpr float kWindowCorrelation = 0.25f;
 // An edge spreads over +-3 rows after the detector's and the residual's smoothing.
@@ -143,9 +143,10 @@ FloorBoundaryFinder::Verdict FloorBoundaryFinder::floor_or_vertical(int column, 
     if (std::abs(vertical_row - contact_row) <= kEdgeBlurRows) continue;
     const float vertical_residual =
         std::abs(inner_.at<float>(row, column) - gain(row, vertical_row) * outer_at(vertical_row, column));
-    // Laplace log-likelihood ratio of the row, less a dead zone of half the scale: what the
-    // model itself leaves (sub-pixel base, interpolation, the gain estimate) must not add up
-    // over a long uniform wall as if it were evidence.
+    // Laplace log-likelihood ratio of the row, less a dead zone: two residuals of independent
+    // noise differ by up to about twice the scale, and what the model itself leaves (sub-pixel
+    // base, interpolation, the gain estimate) is smaller still; neither must add up over a
+    // long uniform wall as if it were evidence.
     const float difference = (vertical_residual - floor_residual) / noise_scale_;
     const float vote = std::clamp(std::copysign(std::max(0.0f, std::abs(difference) - kDeadZone), difference),
                                   -kMaxRowVote, kMaxRowVote);
