@@ -64,7 +64,8 @@ TEST_CASE("the red cube's front face is found at x = 1.3 m", "[stereo][scan][con
 TEST_CASE("integer rows and the thesis table are less accurate than sub-pixel + exact", "[stereo][scan]") {
   const cv::Mat image = cv::imread(kConventionImage, cv::IMREAD_GRAYSCALE);
   const auto wall_error = [&image](SubpixelMethod subpixel, TriangulationMethod triangulation) {
-    ScanConfig config;
+    ScanConfig config;  // the DP stereo path: the floor boundary ranges by the floor plane
+    config.stereo.boundary = omnislam::stereo::BoundaryMethod::kNearestEdge;
     config.stereo.subpixel = subpixel;
     config.stereo.triangulation = triangulation;
     ScanReconstructor reconstructor(config);

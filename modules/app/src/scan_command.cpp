@@ -39,8 +39,8 @@ void print_summary(const std::string &image, const stereo::LocalScan &scan) {
     std::fprintf(stderr,
                  "%s: floor boundary: floor texture %d, floor contacts %d (undecided %d), elevated %d, "
                  "unexplained %d, residual scale %.4f\n",
-                 image.c_str(), s.floor_texture_edges, s.floor_contacts, s.undecided, s.elevated, s.unexplained,
-                 static_cast<double>(s.noise_scale));
+                 image.c_str(), s.floor_texture_edges, s.floor_contacts, s.undecided, s.elevated,
+                 s.unexplained, static_cast<double>(s.noise_scale));
   }
 }
 

@@ -128,7 +128,8 @@ void read_stereo(YamlSection &section, stereo::StereoConfig &stereo) {
       floor.fail("max_edges_per_column", "must be 1..64");
     if (!(config.contact_margin_px > 0.0 && config.contact_margin_px <= 10.0))
       floor.fail("contact_margin_px", "must be in (0, 10]");
-    if (!(config.error_rate > 0.0 && config.error_rate < 0.5)) floor.fail("error_rate", "must be in (0, 0.5)");
+    if (!(config.error_rate > 0.0 && config.error_rate < 0.5))
+      floor.fail("error_rate", "must be in (0, 0.5)");
   }
   if (!(stereo.max_range_m > stereo.min_range_m)) section.fail("max_range_m", "must exceed min_range_m");
   if (!(stereo.far_cutoff_m > stereo.near_cutoff_m))

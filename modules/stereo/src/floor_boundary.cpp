@@ -7,7 +7,6 @@
 #include <numbers>
 #include <opencv2/imgproc.hpp>
 
-
 namespace omnislam::stereo {
 namespace {
 
@@ -16,6 +15,8 @@ constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
 constexpr float kMinNoiseScale = 1.0f / 255.0f;
 // Below this the ratio of two intensities says nothing (the black surround, deep shadow).
 constexpr float kDarkLevel = 0.02f;
+// Image radii enter the lobes' gain model in units of the thesis image radius.
+constexpr float kRadiusUnitPx = 512.0f;
 // Each row's vote is capped (an occlusion edge or a highlight is one bad row, not proof)
 // and halved: the residuals of neighbouring rows share the 5x5 smoothing.
 constexpr float kMaxRowVote = 3.0f;
@@ -37,35 +38,42 @@ float median_of(std::vector<float> &values) {
   return *middle;
 }
 
-// r_o^2 - r_i^2 in units of 512 px (the thesis image radius), the regressor of the gain.
-double radius_term(const FloorGeometry &geometry, int inner_row, float outer_row) {
-  const double inner = geometry.inner_radius_px(static_cast<float>(inner_row)) / 512.0;
-  const double outer = geometry.outer_radius_px(outer_row) / 512.0;
-  return outer * outer - inner * inner;
-}
-
 }  // namespace
 
+float FloorBoundaryFinder::radius_term(int inner_row, float outer_row) const {
+  const float outer = geometry_->outer_radius_px(outer_row) / kRadiusUnitPx;
+  return outer * outer - inner_radius_squared_[static_cast<std::size_t>(inner_row)];
+}
+
 float FloorBoundaryFinder::gain(int inner_row, float outer_row) const {
-  return gain_at_centre_ + gain_slope_ * static_cast<float>(radius_term(*geometry_, inner_row, outer_row));
+  return gain_at_centre_ + gain_slope_ * radius_term(inner_row, outer_row);
 }
 
 FloorBoundaryFinder::FloorBoundaryFinder(const FloorBoundaryConfig &config)
     : config_(config), decision_llr_(std::log((1.0 - config.error_rate) / config.error_rate)) {}
 
 float FloorBoundaryFinder::outer_at(float row, int column) const {
-  const float clamped = std::clamp(row, 0.0f, static_cast<float>(outer_.rows - 1));
-  const int below = std::min(outer_.rows - 2, static_cast<int>(clamped));
+  const float clamped = std::clamp(row, 0.0f, static_cast<float>(rows_ - 1));
+  const int below = std::min(rows_ - 2, static_cast<int>(clamped));
   const float fraction = clamped - static_cast<float>(below);
-  const float a = outer_.at<float>(below, column), b = outer_.at<float>(below + 1, column);
-  return a + fraction * (b - a);
+  const float *line = outer_.ptr<float>(column);
+  return line[below] + fraction * (line[below + 1] - line[below]);
 }
 
 void FloorBoundaryFinder::prepare(const cv::Mat &inner_texture, const cv::Mat &outer_texture) {
-  cv::GaussianBlur(inner_texture, inner_, cv::Size(5, 5), 1.0, 1.0, cv::BORDER_REPLICATE);
-  cv::GaussianBlur(outer_texture, outer_, cv::Size(5, 5), 1.0, 1.0, cv::BORDER_REPLICATE);
-  const int rows = inner_.rows, columns = inner_.cols;
-  floor_residual_.create(rows, columns, CV_32FC1);
+  // Smoothed, then stored column by column: every later loop walks one column's rows.
+  cv::GaussianBlur(inner_texture, smoothed_, cv::Size(5, 5), 1.0, 1.0, cv::BORDER_REPLICATE);
+  cv::transpose(smoothed_, inner_);
+  cv::GaussianBlur(outer_texture, smoothed_, cv::Size(5, 5), 1.0, 1.0, cv::BORDER_REPLICATE);
+  cv::transpose(smoothed_, outer_);
+  rows_ = inner_texture.rows;
+  const int rows = rows_, columns = inner_texture.cols;
+  inner_radius_squared_.resize(static_cast<std::size_t>(rows));
+  for (int row = 0; row < rows; ++row) {
+    const float radius = geometry_->inner_radius_px(static_cast<float>(row)) / kRadiusUnitPx;
+    inner_radius_squared_[static_cast<std::size_t>(row)] = radius * radius;
+  }
+  floor_residual_.create(columns, rows, CV_32FC1);
   floor_residual_.setTo(kNaN);
   // The lobes differ in brightness by the mirror's reflectance and the lens's radial
   // falloff (vignetting), both functions of the image radius. Fit the first-order model of
@@ -78,11 +86,11 @@ void FloorBoundaryFinder::prepare(const cv::Mat &inner_texture, const cv::Mat &o
     if (!std::isfinite(outer_row)) continue;
     ratios_.clear();
     for (int column = 0; column < columns; ++column) {
-      const float inner = inner_.at<float>(row, column), outer = outer_at(outer_row, column);
+      const float inner = inner_px(row, column), outer = outer_at(outer_row, column);
       if (inner > kDarkLevel && outer > kDarkLevel) ratios_.push_back(inner / outer);
     }
     if (ratios_.size() * 2 < static_cast<std::size_t>(columns)) continue;
-    const double x = radius_term(*geometry_, row, outer_row), y = median_of(ratios_);
+    const double x = radius_term(row, outer_row), y = median_of(ratios_);
     sxx += x * x, sx += x, sy += y, sxy += x * y, n += 1.0;
   }
   const double determinant = n * sxx - sx * sx;
@@ -98,51 +106,53 @@ void FloorBoundaryFinder::prepare(const cv::Mat &inner_texture, const cv::Mat &o
     if (!std::isfinite(outer_row)) continue;
     const float g = gain(row, outer_row);
     for (int column = 0; column < columns; ++column) {
-      floor_residual_.at<float>(row, column) = std::abs(inner_.at<float>(row, column) - g * outer_at(outer_row, column));
+      floor_residual_.ptr<float>(column)[row] =
+          std::abs(inner_px(row, column) - g * outer_at(outer_row, column));
     }
   }
   // Noise scale from the rows nearest the robot, mostly floor in any room: a Laplace
   // distribution's scale is its median absolute value over ln 2.
+  // (every other column is plenty for a median)
   ratios_.clear();
   for (int row = rows / 2; row < rows; ++row) {
-    for (int column = 0; column < columns; ++column) {
-      const float residual = floor_residual_.at<float>(row, column);
+    for (int column = 0; column < columns; column += 2) {
+      const float residual = floor_residual_.ptr<float>(column)[row];
       if (std::isfinite(residual)) ratios_.push_back(residual);
     }
   }
   const float median = median_of(ratios_);
-  noise_scale_ = std::isfinite(median) ? std::max(kMinNoiseScale, median / std::numbers::ln2_v<float>)
-                                       : kMinNoiseScale;
+  noise_scale_ =
+      std::isfinite(median) ? std::max(kMinNoiseScale, median / std::numbers::ln2_v<float>) : kMinNoiseScale;
 }
 
 float FloorBoundaryFinder::window_cost(int inner_row, float outer_row, int column,
                                        const vision::EdgeSelectionConfig &window) const {
   float sum = 0.0f;
-  const int rows = inner_.rows;
+  const int rows = rows_, columns = inner_.rows;
   for (int dc = -window.half_window_columns; dc <= window.half_window_columns; ++dc) {
-    const int col = (column + dc + inner_.cols) % inner_.cols;
+    const int col = (column + dc + columns) % columns;
     for (int dr = -window.half_window_rows; dr <= window.half_window_rows; ++dr) {
       const int row = std::clamp(inner_row + dr, 0, rows - 1);
-      sum += std::abs(inner_.at<float>(row, col) -
-                      gain(row, outer_row + static_cast<float>(dr)) * outer_at(outer_row + static_cast<float>(dr), col));
+      sum += std::abs(inner_px(row, col) - gain(row, outer_row + static_cast<float>(dr)) *
+                                               outer_at(outer_row + static_cast<float>(dr), col));
     }
   }
   return sum;
 }
 
 FloorBoundaryFinder::Verdict FloorBoundaryFinder::floor_or_vertical(int column, float edge_row,
-                                                                     float contact_row) const {
+                                                                    float contact_row) const {
   // Wald's sequential test, rows outwards from the edge. Rows inside the edge's own blur,
   // in either lobe, measure the sub-pixel placement of a steep edge rather than the
   // hypotheses, and do not vote.
   double llr = 0.0;
   for (int row = static_cast<int>(edge_row) - kEdgeBlurRows; row >= 0; --row) {
-    const float floor_residual = floor_residual_.at<float>(row, column);
+    const float floor_residual = floor_residual_.ptr<float>(column)[row];
     const float vertical_row = geometry_->vertical_outer_row_at(row, edge_row);
     if (!std::isfinite(floor_residual) || !std::isfinite(vertical_row)) continue;
     if (std::abs(vertical_row - contact_row) <= kEdgeBlurRows) continue;
     const float vertical_residual =
-        std::abs(inner_.at<float>(row, column) - gain(row, vertical_row) * outer_at(vertical_row, column));
+        std::abs(inner_px(row, column) - gain(row, vertical_row) * outer_at(vertical_row, column));
     // Laplace log-likelihood ratio of the row, less a dead zone: two residuals of independent
     // noise differ by up to about twice the scale, and what the model itself leaves (sub-pixel
     // base, interpolation, the gain estimate) is smaller still; neither must add up over a
@@ -157,13 +167,15 @@ FloorBoundaryFinder::Verdict FloorBoundaryFinder::floor_or_vertical(int column, 
   return Verdict::kUndecided;
 }
 
-BoundaryStats FloorBoundaryFinder::find(const FloorGeometry &geometry, const cv::Mat &inner_texture, const cv::Mat &outer_texture,
-                                        const vision::EdgeImage &inner_edges, const vision::EdgeImage &outer_edges,
+BoundaryStats FloorBoundaryFinder::find(const FloorGeometry &geometry, const cv::Mat &inner_texture,
+                                        const cv::Mat &outer_texture, const vision::EdgeImage &inner_edges,
+                                        const vision::EdgeImage &outer_edges,
                                         const vision::ColumnEdges &inner_candidates,
-                                        const vision::ColumnEdges &outer_candidates, const DisparityLimits &limits,
-                                        const RowTriangulator &triangulator,
+                                        const vision::ColumnEdges &outer_candidates,
+                                        const DisparityLimits &limits, const RowTriangulator &triangulator,
                                         const vision::EdgeSelectionConfig &window,
-                                        std::vector<BoundaryPoint> &points, std::vector<float> &free_range_m) {
+                                        std::vector<BoundaryPoint> &points,
+                                        std::vector<float> &free_range_m) {
   geometry_ = &geometry;
   prepare(inner_texture, outer_texture);
   BoundaryStats stats;
@@ -174,7 +186,7 @@ BoundaryStats FloorBoundaryFinder::find(const FloorGeometry &geometry, const cv:
   free_range_m.assign(static_cast<std::size_t>(inner_candidates.columns()), kNaN);
   for (int column = 0; column < inner_candidates.columns(); ++column) {
     const auto outer_edges_here = outer_candidates.column(column);
-    float free_end_m = kNaN;       // an edge off the floor that nothing explains
+    float free_end_m = kNaN;        // an edge off the floor that nothing explains
     float farthest_floor_m = kNaN;  // the farthest edge found to be floor texture
     float boundary_m = kNaN;
     for (const vision::EdgePoint &edge : inner_candidates.column(column)) {
@@ -213,7 +225,8 @@ BoundaryStats FloorBoundaryFinder::find(const FloorGeometry &geometry, const cv:
         }
         if (match == nullptr && !std::isfinite(floor_row)) {
           ++stats.unexplained;
-          if (!std::isfinite(free_end_m)) free_end_m = static_cast<float>(geometry_->floor_range_at(edge.row_subpx));
+          if (!std::isfinite(free_end_m))
+            free_end_m = static_cast<float>(geometry_->floor_range_at(edge.row_subpx));
           continue;
         }
       }
@@ -221,7 +234,8 @@ BoundaryStats FloorBoundaryFinder::find(const FloorGeometry &geometry, const cv:
         const auto stereo = triangulator.triangulate(edge.row_subpx, match->row_subpx);
         if (!stereo) continue;
         ++stats.elevated;
-        points.push_back({column, edge.row_subpx, match->row_subpx, stereo->range_m, stereo->height_m, false});
+        points.push_back(
+            {column, edge.row_subpx, match->row_subpx, stereo->range_m, stereo->height_m, false});
         boundary_m = static_cast<float>(stereo->range_m);
         break;
       }

@@ -54,17 +54,10 @@ float FloorGeometry::floor_outer_row_at(float inner_row) const {
          fraction * (floor_outer_row_[index(below + 1)] - floor_outer_row_[index(below)]);
 }
 
-float FloorGeometry::vertical_outer_row_at(int row, float base_row) const {
-  const int below = static_cast<int>(base_row);
-  if (row >= below || below + 1 >= rows_) return kNaN;
-  const float fraction = base_row - static_cast<float>(below);
-  const float a = vertical_outer_row(row, below), b = vertical_outer_row(row, below + 1);
-  return a + fraction * (b - a);
-}
-
 double FloorGeometry::floor_range_at(double inner_row) const {
   using mirror::Lobe;
-  const mirror::MeridianRay ray = model_.back_project(Lobe::kInner, model_.radius_px_of_row(Lobe::kInner, inner_row));
+  const mirror::MeridianRay ray =
+      model_.back_project(Lobe::kInner, model_.radius_px_of_row(Lobe::kInner, inner_row));
   if (!(ray.theta_rad < std::numbers::pi / 2.0)) return std::numeric_limits<double>::quiet_NaN();
   return ray.origin.range_m + (ray.origin.height_m + camera_height_m_) * std::tan(ray.theta_rad);
 }

@@ -123,9 +123,9 @@ void ScanReconstructor::match() {
   matches_.clear();
   match_stats_ = {};
   if (floor_boundary()) {
-    boundary_stats_ = boundary_finder_.find(floor_geometry_, inner_.texture, outer_.texture, inner_.edges, outer_.edges,
-                                            inner_.candidates, outer_.candidates, limits_, triangulator_, selection_,
-                                            boundary_points_, free_range_m_);
+    boundary_stats_ = boundary_finder_.find(floor_geometry_, inner_.texture, outer_.texture, inner_.edges,
+                                            outer_.edges, inner_.candidates, outer_.candidates, limits_,
+                                            triangulator_, selection_, boundary_points_, free_range_m_);
     return;
   }
   for (int column = 0; column < inner_.candidates.columns(); ++column) {
@@ -153,8 +153,8 @@ void ScanReconstructor::triangulate(LocalScan &scan) {
   }
 }
 
-void ScanReconstructor::add_point(int column, double range_m, double height_m, float inner_row, float outer_row,
-                                  LocalScan &scan) {
+void ScanReconstructor::add_point(int column, double range_m, double height_m, float inner_row,
+                                  float outer_row, LocalScan &scan) {
   if (range_m < config_.stereo.near_cutoff_m || range_m > config_.stereo.far_cutoff_m) {
     ++scan.stats.outside_cutoffs;
     return;
@@ -177,7 +177,8 @@ void ScanReconstructor::build_boundary_scan(LocalScan &scan) {
     add_point(point.column, point.range_m, point.height_m, point.inner_row, point.outer_row, scan);
   }
   // One boundary per column already; the per-degree filter matters only for finer panoramas.
-  if (config_.stereo.one_point_per_degree) scan.stats.filtered_out = keep_nearest_per_degree(scan.points, filtered_);
+  if (config_.stereo.one_point_per_degree)
+    scan.stats.filtered_out = keep_nearest_per_degree(scan.points, filtered_);
   scan.stats.points = static_cast<int>(scan.points.size());
   scan.free_range_m = free_range_m_;
 }

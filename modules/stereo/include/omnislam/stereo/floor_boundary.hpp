@@ -67,7 +67,8 @@ class FloorBoundaryFinder {
   /// Finds the boundary of every column. `inner`/`outer` textures are CV_32FC1 in [0, 1];
   /// the candidates are every horizontal edge of each column, nearest first.
   /// `free_range_m` gets, per column, how far the floor was seen to be free (NaN: unknown).
-  BoundaryStats find(const FloorGeometry &geometry, const cv::Mat &inner_texture, const cv::Mat &outer_texture, const vision::EdgeImage &inner_edges,
+  BoundaryStats find(const FloorGeometry &geometry, const cv::Mat &inner_texture,
+                     const cv::Mat &outer_texture, const vision::EdgeImage &inner_edges,
                      const vision::EdgeImage &outer_edges, const vision::ColumnEdges &inner_candidates,
                      const vision::ColumnEdges &outer_candidates, const DisparityLimits &limits,
                      const RowTriangulator &triangulator, const vision::EdgeSelectionConfig &window,
@@ -79,6 +80,9 @@ class FloorBoundaryFinder {
   enum class Verdict { kFloor, kVertical, kUndecided };
   [[nodiscard]] Verdict floor_or_vertical(int column, float edge_row, float contact_row) const;
   [[nodiscard]] float outer_at(float row, int column) const;
+  [[nodiscard]] float inner_px(int row, int column) const { return inner_.ptr<float>(column)[row]; }
+  /// r_o^2 - r_i^2, radii in units of 512 px: the regressor of the lobes' gain.
+  [[nodiscard]] float radius_term(int inner_row, float outer_row) const;
   /// Gain-compensated SAD of the inner window at `inner_row` and the outer one at
   /// `outer_row` (fractional), on the smoothed textures.
   [[nodiscard]] float window_cost(int inner_row, float outer_row, int column,
@@ -87,9 +91,12 @@ class FloorBoundaryFinder {
   const FloorGeometry *geometry_ = nullptr;  ///< of the current find() call
   FloorBoundaryConfig config_;
   double decision_llr_ = 0.0;
-  cv::Mat inner_;           ///< smoothed inner texture
-  cv::Mat outer_;           ///< smoothed outer texture
-  cv::Mat floor_residual_;  ///< |inner - gain * outer at the floor row|, per inner row and column
+  int rows_ = 0;
+  cv::Mat smoothed_;
+  cv::Mat inner_;           ///< smoothed inner texture, transposed: one matrix row per column
+  cv::Mat outer_;           ///< smoothed outer texture, transposed
+  cv::Mat floor_residual_;  ///< |inner - gain * outer at the floor row|, transposed like them
+  std::vector<float> inner_radius_squared_;
   /// Brightness of the inner lobe over the outer lobe for the same scene point, seen at
   /// image radii r_i and r_o: reflectance ratio times radial falloff to first order,
   /// gain_at_centre_ + gain_slope_ * (r_o^2 - r_i^2) (radii in units of 512 px).

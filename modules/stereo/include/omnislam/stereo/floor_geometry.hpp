@@ -1,5 +1,6 @@
 #pragma once
 
+#include <limits>
 #include <vector>
 
 #include "omnislam/mirror/mirror_model.hpp"
@@ -42,7 +43,13 @@ class FloorGeometry {
   [[nodiscard]] float inner_radius_px(float row) const { return inner_radius_offset_px_ - row; }
   [[nodiscard]] float outer_radius_px(float row) const { return outer_radius_offset_px_ - row; }
   /// The same for a fractional base row (linear between the two base rows around it).
-  [[nodiscard]] float vertical_outer_row_at(int row, float base_row) const;
+  [[nodiscard]] float vertical_outer_row_at(int row, float base_row) const {
+    const int below = static_cast<int>(base_row);
+    if (row >= below || below + 1 >= rows_) return std::numeric_limits<float>::quiet_NaN();
+    const float fraction = base_row - static_cast<float>(below);
+    const float a = vertical_outer_row(row, below), b = vertical_outer_row(row, below + 1);
+    return a + fraction * (b - a);
+  }
 
  private:
   [[nodiscard]] static std::size_t index(int row) { return static_cast<std::size_t>(row); }

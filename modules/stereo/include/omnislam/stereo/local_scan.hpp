@@ -49,7 +49,7 @@ struct ScanStats {
   int elevated = 0;             ///< boundaries above the floor (triangulated)
   int unexplained = 0;          ///< edges off the floor without an outer match
   float noise_scale = 0.0f;     ///< photometric residual scale (intensity in [0, 1])
-  int points = 0;           ///< points in the scan
+  int points = 0;               ///< points in the scan
 };
 
 enum class ScanStatus {
@@ -60,9 +60,9 @@ enum class ScanStatus {
 struct LocalScan {
   ScanStatus status = ScanStatus::kOk;
   std::vector<ScanPoint> points;  ///< ordered by azimuth, then bottom-up within a column
-  /// Per panorama column (column j at azimuth (j + 0.5) * 360 / columns deg + the offset), how far the floor was seen to
-  /// be free (m): up to the boundary found, or up to the farthest floor texture where none
-  /// was; NaN where nothing was seen. Empty for the nearest-edge method.
+  /// Per panorama column (column j at azimuth (j + 0.5) * 360 / columns deg + the offset), how far the floor
+  /// was seen to be free (m): up to the boundary found, or up to the farthest floor texture where none was;
+  /// NaN where nothing was seen. Empty for the nearest-edge method.
   std::vector<float> free_range_m;
   ScanStats stats;
 };

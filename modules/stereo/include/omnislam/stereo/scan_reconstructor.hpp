@@ -71,9 +71,12 @@ class ScanReconstructor {
   void build_scan(const std::vector<RowMatch> &matches, LocalScan &scan);
 
  private:
-  [[nodiscard]] bool floor_boundary() const { return config_.stereo.boundary == BoundaryMethod::kFloorBoundary; }
+  [[nodiscard]] bool floor_boundary() const {
+    return config_.stereo.boundary == BoundaryMethod::kFloorBoundary;
+  }
   void build_boundary_scan(LocalScan &scan);
-  void add_point(int column, double range_m, double height_m, float inner_row, float outer_row, LocalScan &scan);
+  void add_point(int column, double range_m, double height_m, float inner_row, float outer_row,
+                 LocalScan &scan);
 
   ScanConfig config_;
   mirror::MirrorModel model_;
