@@ -61,6 +61,24 @@ void ScanAccuracy::add(const stereo::LocalScan &scan, const Pose2 &pose,
     ++coverable_degrees;
     if (degree_has_point[static_cast<std::size_t>(degree)]) ++covered_degrees;
   }
+  const int free_columns = static_cast<int>(scan.free_range_m.size());
+  for (int column = 0; column < free_columns; ++column) {
+    ++columns;
+    const float free_m = scan.free_range_m[static_cast<std::size_t>(column)];
+    if (!std::isfinite(free_m)) continue;
+    ++free_known;
+    const double azimuth = (column + 0.5) * 2.0 * std::numbers::pi / free_columns;
+    const auto truth = ray_cast_m(segments, pose.x_m, pose.y_m, pose.yaw_rad + azimuth);
+    if (truth && free_m > *truth + segment_tolerance_m) ++free_beyond_truth;
+  }
+}
+
+double ScanAccuracy::free_known_share() const {
+  return columns > 0 ? static_cast<double>(free_known) / columns : 0.0;
+}
+
+double ScanAccuracy::free_overclaim_share() const {
+  return free_known > 0 ? static_cast<double>(free_beyond_truth) / free_known : 0.0;
 }
 
 double ScanAccuracy::quantile_relative_error(double q) const {
@@ -91,7 +109,14 @@ std::string ScanAccuracy::summary() const {
                 100.0 * median_relative_error(), 100.0 * quantile_relative_error(0.9),
                 100.0 * near_segment_share(), segment_tolerance_m, 100.0 * coverage(), coverable_degrees,
                 coverage_range_m);
-  return text;
+  std::string out = text;
+  if (columns > 0) {
+    std::snprintf(text, sizeof text,
+                  "; free range known in %.1f%% of columns, beyond the plan in %.1f%% of those",
+                  100.0 * free_known_share(), 100.0 * free_overclaim_share());
+    out += text;
+  }
+  return out;
 }
 
 TruthDataset load_truth_dataset(const std::filesystem::path &dir) {

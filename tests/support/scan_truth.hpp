@@ -42,6 +42,11 @@ struct ScanAccuracy {
   int points_near_segment = 0;
   int coverable_degrees = 0;
   int covered_degrees = 0;
+  // Free range per column (floor-boundary scans): columns with one, and of those the ones
+  // claiming free floor more than segment_tolerance_m beyond the first structure.
+  int columns = 0;
+  int free_known = 0;
+  int free_beyond_truth = 0;
   int frames = 0;
 
   void add(const stereo::LocalScan &scan, const Pose2 &pose,
@@ -51,6 +56,8 @@ struct ScanAccuracy {
   [[nodiscard]] double quantile_relative_error(double q) const;
   [[nodiscard]] double near_segment_share() const;
   [[nodiscard]] double coverage() const;
+  [[nodiscard]] double free_known_share() const;
+  [[nodiscard]] double free_overclaim_share() const;
   [[nodiscard]] std::string summary() const;
 };
 
