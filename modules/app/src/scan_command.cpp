@@ -3,10 +3,12 @@
 #include <cstdio>
 #include <memory>
 #include <numbers>
+#include <stdexcept>
 #include <string>
 
 #include "omnislam/io/config.hpp"
 #include "omnislam/io/image_file.hpp"
+#include "omnislam/mirror/panorama_maps.hpp"
 #include "omnislam/stereo/scan_reconstructor.hpp"
 
 namespace omnislam::app {
@@ -18,6 +20,7 @@ struct ScanOptions {
   std::string image;
   std::string config;
   bool quiet = false;
+  bool free = false;
 };
 
 void print_csv(const stereo::LocalScan &scan) {
@@ -25,6 +28,15 @@ void print_csv(const stereo::LocalScan &scan) {
   for (const stereo::ScanPoint &p : scan.points) {
     std::printf("%.3f,%.4f,%.4f,%.4f,%.4f,%.3f,%.3f\n", p.azimuth_rad * kDegPerRad, p.range_m, p.x_m, p.y_m,
                 p.z_m, static_cast<double>(p.inner_row), static_cast<double>(p.outer_row));
+  }
+}
+
+// Free floor per panorama column (floor-boundary scans): "nan" where nothing was seen.
+void print_free_csv(const stereo::LocalScan &scan, const mirror::MirrorConfig &camera) {
+  std::printf("azimuth_deg,free_range_m\n");
+  for (std::size_t column = 0; column < scan.free_range_m.size(); ++column) {
+    const double azimuth_deg = mirror::column_azimuth_rad(camera, static_cast<int>(column)) * kDegPerRad;
+    std::printf("%.3f,%.4f\n", azimuth_deg, static_cast<double>(scan.free_range_m[column]));
   }
 }
 
@@ -52,12 +64,20 @@ void add_scan_command(CLI::App &app) {
   command->add_option("IMAGE", options->image, "8-bit image of the configured camera size")->required();
   command->add_option("--config", options->config, "YAML configuration (camera, vision, stereo)");
   command->add_flag("--quiet", options->quiet, "no summary on stderr");
+  command->add_flag("--free", options->free,
+                    "print how far the floor was seen to be free per column instead "
+                    "(azimuth_deg,free_range_m; nan where unknown)");
   command->callback([options] {
     const io::Config config = options->config.empty() ? io::Config{} : io::load_config(options->config);
     const cv::Mat image = io::read_camera_image(options->image, config.scan.camera);
     stereo::ScanReconstructor reconstructor(config.scan);
     const stereo::LocalScan scan = reconstructor.reconstruct(image);
-    print_csv(scan);
+    if (options->free) {
+      if (scan.free_range_m.empty()) throw std::runtime_error("--free needs stereo.boundary: floor_boundary");
+      print_free_csv(scan, config.scan.camera);
+    } else {
+      print_csv(scan);
+    }
     if (!options->quiet) print_summary(options->image, scan);
   });
 }
