@@ -73,8 +73,23 @@ void FloorBoundaryFinder::prepare(const cv::Mat &inner_texture, const cv::Mat &o
     const float radius = geometry_->inner_radius_px(static_cast<float>(row)) / kRadiusUnitPx;
     inner_radius_squared_[static_cast<std::size_t>(row)] = radius * radius;
   }
+  fit_lobe_gain();
   floor_residual_.create(columns, rows, CV_32FC1);
   floor_residual_.setTo(kNaN);
+  for (int row = 0; row < rows; ++row) {
+    const float outer_row = geometry_->floor_outer_row(row);
+    if (!std::isfinite(outer_row)) continue;
+    const float g = gain(row, outer_row);
+    for (int column = 0; column < columns; ++column) {
+      floor_residual_.ptr<float>(column)[row] =
+          std::abs(inner_px(row, column) - g * outer_at(outer_row, column));
+    }
+  }
+  measure_noise_scale();
+}
+
+void FloorBoundaryFinder::fit_lobe_gain() {
+  const int rows = rows_, columns = inner_.rows;
   // The lobes differ in brightness by the mirror's reflectance and the lens's radial
   // falloff (vignetting), both functions of the image radius. Fit the first-order model of
   // gain() to the median brightness ratio of each row nearest the robot, where nearly
@@ -101,18 +116,12 @@ void FloorBoundaryFinder::prepare(const cv::Mat &inner_texture, const cv::Mat &o
   } else if (n >= 1.0) {
     gain_at_centre_ = static_cast<float>(sy / n);
   }
-  for (int row = 0; row < rows; ++row) {
-    const float outer_row = geometry_->floor_outer_row(row);
-    if (!std::isfinite(outer_row)) continue;
-    const float g = gain(row, outer_row);
-    for (int column = 0; column < columns; ++column) {
-      floor_residual_.ptr<float>(column)[row] =
-          std::abs(inner_px(row, column) - g * outer_at(outer_row, column));
-    }
-  }
-  // Noise scale from the rows nearest the robot, mostly floor in any room: a Laplace
-  // distribution's scale is its median absolute value over ln 2.
-  // (every other column is plenty for a median)
+}
+
+void FloorBoundaryFinder::measure_noise_scale() {
+  const int rows = rows_, columns = inner_.rows;
+  // From the rows nearest the robot, mostly floor in any room: a Laplace distribution's
+  // scale is its median absolute value over ln 2 (every other column is plenty).
   ratios_.clear();
   for (int row = rows / 2; row < rows; ++row) {
     for (int column = 0; column < columns; column += 2) {

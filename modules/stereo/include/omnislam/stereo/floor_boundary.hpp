@@ -75,7 +75,10 @@ class FloorBoundaryFinder {
                      std::vector<BoundaryPoint> &points, std::vector<float> &free_range_m);
 
  private:
+  /// Smoothed column-major textures, the lobes' gain, the floor residuals, the noise scale.
   void prepare(const cv::Mat &inner_texture, const cv::Mat &outer_texture);
+  void fit_lobe_gain();
+  void measure_noise_scale();
   /// Log-likelihood ratio, floor over vertical surface, of the rows above `edge_row`.
   enum class Verdict { kFloor, kVertical, kUndecided };
   [[nodiscard]] Verdict floor_or_vertical(int column, float edge_row, float contact_row) const;
