@@ -79,7 +79,8 @@ class FloorBoundaryFinder {
   void prepare(const cv::Mat &inner_texture, const cv::Mat &outer_texture);
   void fit_lobe_gain();
   void measure_noise_scale();
-  /// Log-likelihood ratio, floor over vertical surface, of the rows above `edge_row`.
+  /// Wald's test over the rows above `edge_row`: floor going on, a vertical surface standing
+  /// at the edge's floor range, or neither decisively (the column ran out of rows).
   enum class Verdict { kFloor, kVertical, kUndecided };
   [[nodiscard]] Verdict floor_or_vertical(int column, float edge_row, float contact_row) const;
   [[nodiscard]] float outer_at(float row, int column) const;
