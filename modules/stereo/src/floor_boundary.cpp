@@ -149,6 +149,12 @@ float FloorBoundaryFinder::window_cost(int inner_row, float outer_row, int colum
   return sum;
 }
 
+float FloorBoundaryFinder::row_vote(float residual_against, float residual_for) const {
+  const float difference = (residual_against - residual_for) / noise_scale_;
+  return std::clamp(std::copysign(std::max(0.0f, std::abs(difference) - kDeadZone), difference), -kMaxRowVote,
+                    kMaxRowVote);
+}
+
 FloorBoundaryFinder::Verdict FloorBoundaryFinder::floor_or_vertical(int column, float edge_row,
                                                                     float contact_row) const {
   // Wald's sequential test, rows outwards from the edge. Rows inside the edge's own blur,
@@ -166,14 +172,57 @@ FloorBoundaryFinder::Verdict FloorBoundaryFinder::floor_or_vertical(int column, 
     // noise differ by up to about twice the scale, and what the model itself leaves (sub-pixel
     // base, interpolation, the gain estimate) is smaller still; neither must add up over a
     // long uniform wall as if it were evidence.
-    const float difference = (vertical_residual - floor_residual) / noise_scale_;
-    const float vote = std::clamp(std::copysign(std::max(0.0f, std::abs(difference) - kDeadZone), difference),
-                                  -kMaxRowVote, kMaxRowVote);
-    llr += kRowCorrelation * vote;
+    llr += kRowCorrelation * row_vote(vertical_residual, floor_residual);
     if (llr >= decision_llr_) return Verdict::kFloor;
     if (llr <= -decision_llr_) return Verdict::kVertical;
   }
   return Verdict::kUndecided;
+}
+
+const vision::EdgePoint *FloorBoundaryFinder::floor_contact(
+    const vision::EdgePoint &edge, int column, const vision::EdgeImage &inner_edges,
+    const vision::EdgeImage &outer_edges, std::span<const vision::EdgePoint> outer_column) const {
+  const float floor_row = geometry_->floor_outer_row_at(edge.row_subpx);
+  const int sign = polarity(inner_edges, edge.row, column);
+  const auto margin = static_cast<float>(config_.contact_margin_px);
+  const vision::EdgePoint *contact = nullptr;
+  for (const vision::EdgePoint &outer : outer_column) {
+    const float offset = std::abs(outer.row_subpx - floor_row);
+    if (offset <= margin && polarity(outer_edges, outer.row, column) == sign &&
+        (contact == nullptr || offset < std::abs(contact->row_subpx - floor_row))) {
+      contact = &outer;
+    }
+  }
+  return contact;
+}
+
+bool FloorBoundaryFinder::farther_base_explains_better(int column, float base_row, float base_contact_row,
+                                                       float farther_row, float farther_contact_row) const {
+  // Rows between the two edges: floor (the farther hypothesis) against the surface standing
+  // at the nearer base; rows beyond the farther edge: a surface standing there against one
+  // standing at the nearer base. Same votes and thresholds as floor_or_vertical().
+  double llr = 0.0;
+  for (int row = static_cast<int>(base_row) - kEdgeBlurRows; row >= 0; --row) {
+    const float near_row = geometry_->vertical_outer_row_at(row, base_row);
+    if (!std::isfinite(near_row) || std::abs(near_row - base_contact_row) <= kEdgeBlurRows) continue;
+    const bool between = static_cast<float>(row) > farther_row - static_cast<float>(kEdgeBlurRows);
+    if (!between && static_cast<float>(row) > farther_row - static_cast<float>(2 * kEdgeBlurRows)) continue;
+    float far_residual = kNaN;
+    if (between) {
+      far_residual = floor_residual_.ptr<float>(column)[row];
+    } else {
+      const float far_row = geometry_->vertical_outer_row_at(row, farther_row);
+      if (std::isfinite(far_row) && std::abs(far_row - farther_contact_row) > kEdgeBlurRows)
+        far_residual = std::abs(inner_px(row, column) - gain(row, far_row) * outer_at(far_row, column));
+    }
+    if (!std::isfinite(far_residual)) continue;
+    const float near_residual =
+        std::abs(inner_px(row, column) - gain(row, near_row) * outer_at(near_row, column));
+    llr += kRowCorrelation * row_vote(near_residual, far_residual);
+    if (llr >= decision_llr_) return true;
+    if (llr <= -decision_llr_) return false;
+  }
+  return false;
 }
 
 BoundaryStats FloorBoundaryFinder::find(const FloorGeometry &geometry, const cv::Mat &inner_texture,
@@ -198,19 +247,15 @@ BoundaryStats FloorBoundaryFinder::find(const FloorGeometry &geometry, const cv:
     float free_end_m = kNaN;        // an edge off the floor that nothing explains
     float farthest_floor_m = kNaN;  // the farthest edge found to be floor texture
     float boundary_m = kNaN;
-    for (const vision::EdgePoint &edge : inner_candidates.column(column)) {
+    const auto inner_edges_here = inner_candidates.column(column);
+    for (std::size_t index = 0; index < inner_edges_here.size(); ++index) {
+      const vision::EdgePoint &edge = inner_edges_here[index];
       ++stats.edges_visited;
       const int sign = polarity(inner_edges, edge.row, column);
       const float floor_row = geometry_->floor_outer_row_at(edge.row_subpx);
       // 1. Is there an outer edge of the same polarity where the floor puts it?
-      const vision::EdgePoint *contact = nullptr;
-      for (const vision::EdgePoint &outer : outer_edges_here) {
-        const float offset = std::abs(outer.row_subpx - floor_row);
-        if (offset <= margin && polarity(outer_edges, outer.row, column) == sign &&
-            (contact == nullptr || offset < std::abs(contact->row_subpx - floor_row))) {
-          contact = &outer;
-        }
-      }
+      const vision::EdgePoint *contact =
+          floor_contact(edge, column, inner_edges, outer_edges, outer_edges_here);
       // 2. If not, the outer edge nearer than the floor that looks most alike; it explains
       //    the edge only when it fits decisively better than the floor's prediction (a
       //    floor edge whose outer twin the detector missed is not a table top).
@@ -249,19 +294,38 @@ BoundaryStats FloorBoundaryFinder::find(const FloorGeometry &geometry, const cv:
         break;
       }
       // 3. On the floor: floor going on, or a vertical surface standing here?
-      const float outer_row = contact != nullptr ? contact->row_subpx : floor_row;
+      float outer_row = contact != nullptr ? contact->row_subpx : floor_row;
       const Verdict verdict = floor_or_vertical(column, edge.row_subpx, outer_row);
-      const auto range_m = static_cast<float>(geometry_->floor_range_at(edge.row_subpx));
       if (verdict == Verdict::kFloor) {
         ++stats.floor_texture;
-        farthest_floor_m = range_m;
+        farthest_floor_m = static_cast<float>(geometry_->floor_range_at(edge.row_subpx));
         continue;
+      }
+      // 4. Floor texture just in front of a wall leaves the wall to explain the rows above
+      //    it, and a surface standing at the texture's range explains them almost as well.
+      //    Would the next edge on the floor, as the base, explain them better (floor up to
+      //    it)? Then this edge was floor texture too.
+      const vision::EdgePoint *base = &edge;
+      for (std::size_t next = index + 1; next < inner_edges_here.size(); ++next) {
+        const vision::EdgePoint &farther = inner_edges_here[next];
+        if (base->row - farther.row < 2 * kEdgeBlurRows) continue;
+        const vision::EdgePoint *farther_contact =
+            floor_contact(farther, column, inner_edges, outer_edges, outer_edges_here);
+        if (farther_contact == nullptr) break;
+        if (!farther_base_explains_better(column, base->row_subpx, outer_row, farther.row_subpx,
+                                          farther_contact->row_subpx))
+          break;
+        ++stats.floor_texture;
+        farthest_floor_m = static_cast<float>(geometry_->floor_range_at(base->row_subpx));
+        base = &farther;
+        outer_row = farther_contact->row_subpx;
       }
       ++stats.floor_contacts;
       if (verdict == Verdict::kUndecided) ++stats.undecided;
-      BoundaryPoint point{column, edge.row_subpx, outer_row, range_m, floor_height_m, true};
+      const auto range_m = static_cast<float>(geometry_->floor_range_at(base->row_subpx));
+      BoundaryPoint point{column, base->row_subpx, outer_row, range_m, floor_height_m, true};
       if (!config_.floor_plane_range) {
-        const auto stereo = triangulator.triangulate(edge.row_subpx, outer_row);
+        const auto stereo = triangulator.triangulate(base->row_subpx, outer_row);
         if (!stereo) continue;
         point.range_m = stereo->range_m;
         point.height_m = stereo->height_m;

@@ -1,6 +1,7 @@
 #pragma once
 
 #include <opencv2/core.hpp>
+#include <span>
 #include <vector>
 
 #include "omnislam/stereo/disparity_limits.hpp"
@@ -84,6 +85,18 @@ class FloorBoundaryFinder {
   enum class Verdict { kFloor, kVertical, kUndecided };
   [[nodiscard]] Verdict floor_or_vertical(int column, float edge_row, float contact_row) const;
   [[nodiscard]] float outer_at(float row, int column) const;
+  /// Vote of one row for the hypothesis with `residual_for` (positive) over the other,
+  /// in residual scales, less the dead zone, capped.
+  [[nodiscard]] float row_vote(float residual_against, float residual_for) const;
+  /// The outer edge of the same polarity where the floor puts `edge`, or nullptr.
+  [[nodiscard]] const vision::EdgePoint *floor_contact(const vision::EdgePoint &edge, int column,
+                                                       const vision::EdgeImage &inner_edges,
+                                                       const vision::EdgeImage &outer_edges,
+                                                       std::span<const vision::EdgePoint> outer_column) const;
+  /// Whether floor up to the farther edge and a surface standing there explain the rows
+  /// beyond the nearer base better than a surface standing at the nearer base.
+  [[nodiscard]] bool farther_base_explains_better(int column, float base_row, float base_contact_row,
+                                                  float farther_row, float farther_contact_row) const;
   [[nodiscard]] float inner_px(int row, int column) const { return inner_.ptr<float>(column)[row]; }
   /// r_o^2 - r_i^2, radii in units of 512 px: the regressor of the lobes' gain.
   [[nodiscard]] float radius_term(int inner_row, float outer_row) const;
