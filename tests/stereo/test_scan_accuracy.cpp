@@ -79,3 +79,20 @@ TEST_CASE("sim-room-37-real: local scans against the floor plan", "[stereo][accu
   CHECK(degraded.free_known_share() >= 0.90);
   CHECK(degraded.free_overclaim_share() <= 0.15);
 }
+
+// The office: hexagon carpet, a pillar, furniture, camera 0.8 m up, robot facing its travel.
+// Measured when written: noise-free 0.39% / 85.1% within 0.1 m / coverage 91.5%; degraded
+// 0.49% / 80.6% / 90.3% (the issue asks >= 90% within 0.1 m: not yet held here; one cause
+// seen: table tops whose edge is missed, so the boundary lands on the floor behind them).
+TEST_CASE("office-real: local scans against the floor plan", "[stereo][accuracy][dataset]") {
+  const omnislam::test::ScanAccuracy clean = scan_accuracy("office-real", 45, false);
+  CHECK(clean.median_relative_error() <= 0.02);
+  CHECK(clean.near_segment_share() >= 0.83);
+  CHECK(clean.coverage() >= 0.85);
+  const omnislam::test::ScanAccuracy degraded = scan_accuracy("office-real", 45, true);
+  CHECK(degraded.median_relative_error() <= 0.02);
+  CHECK(degraded.near_segment_share() >= 0.78);
+  CHECK(degraded.coverage() >= 0.85);
+  CHECK(degraded.free_known_share() >= 0.90);
+  CHECK(degraded.free_overclaim_share() <= 0.15);
+}
