@@ -105,12 +105,11 @@ def test_replay_names_a_missing_dataset(tmp_path):
 
 # Realistic datasets (textured floors, soft shadows, sunlight) with every sensor factor of
 # the degradation stage on (replay --degrade all, seed 1): the front-end issue's acceptance.
-# Measured when written: sim-room-37-real max 5.5 mm, map median 4.2 mm, completeness 64.7%
-# (the issue asks <= 60 mm, <= 30 mm, >= 65%: completeness not yet held); office-real
-# (camera 0.8 m) max 6.1 mm, map median 11.4 mm, completeness 76.4% (<= 80 mm, <= 30 mm,
-# >= 65%).
+# The issue's acceptance. Measured when written: sim-room-37-real max 15.4 mm, map median
+# 7.6 mm, completeness 66.2% (asks <= 60 mm, <= 30 mm, >= 65%); office-real (camera 0.8 m)
+# max 9.3 mm, map median 9.5 mm, completeness 70.3% (<= 80 mm, <= 30 mm, >= 65%).
 REALISTIC = {
-    "sim-room-37-real": {"frames": 37, "max_m": 0.060, "median_m": 0.030, "completeness": 0.62},
+    "sim-room-37-real": {"frames": 37, "max_m": 0.060, "median_m": 0.030, "completeness": 0.65},
     "office-real": {"frames": 45, "max_m": 0.080, "median_m": 0.030, "completeness": 0.65},
 }
 

@@ -226,6 +226,41 @@ bool FloorBoundaryFinder::farther_base_explains_better(int column, float base_ro
   return false;
 }
 
+const vision::EdgePoint *FloorBoundaryFinder::elevated_match(
+    const vision::EdgePoint &edge, int column, const vision::EdgeImage &inner_edges,
+    const vision::EdgeImage &outer_edges, std::span<const vision::EdgePoint> outer_column,
+    const DisparityLimits &limits, const vision::EdgeSelectionConfig &window) const {
+  const DisparityBand &band = limits.per_inner_row[static_cast<std::size_t>(edge.row)];
+  const float floor_row = geometry_->floor_outer_row_at(edge.row_subpx);
+  const float floor_disparity = floor_row - edge.row_subpx;
+  const int sign = polarity(inner_edges, edge.row, column);
+  const auto margin = static_cast<float>(config_.contact_margin_px);
+  const vision::EdgePoint *match = nullptr;
+  float best_cost = std::numeric_limits<float>::infinity(), second_cost = best_cost;
+  for (const vision::EdgePoint &outer : outer_column) {
+    const float disparity = outer.row_subpx - edge.row_subpx;
+    if (!band.contains(static_cast<float>(outer.row - edge.row)) ||
+        polarity(outer_edges, outer.row, column) != sign)
+      continue;
+    if (std::isfinite(floor_disparity) && !(disparity > floor_disparity + margin)) continue;
+    const float cost = window_cost(edge.row, outer.row_subpx, column, window);
+    if (cost < best_cost) {
+      second_cost = best_cost, best_cost = cost, match = &outer;
+    } else {
+      second_cost = std::min(second_cost, cost);
+    }
+  }
+  // Decisively better than the floor's prediction and than any other candidate: a table
+  // top's two edges (top and underside) or a textured floor offer several near-equal ones.
+  const auto decisive = [this, best_cost](float other_cost) {
+    return !std::isfinite(other_cost) ||
+           kWindowCorrelation * (other_cost - best_cost) / noise_scale_ >= decision_llr_;
+  };
+  if (match == nullptr || !decisive(second_cost)) return nullptr;
+  if (std::isfinite(floor_row) && !decisive(window_cost(edge.row, floor_row, column, window))) return nullptr;
+  return match;
+}
+
 BoundaryStats FloorBoundaryFinder::find(const FloorGeometry &geometry, const cv::Mat &inner_texture,
                                         const cv::Mat &outer_texture, const vision::EdgeImage &inner_edges,
                                         const vision::EdgeImage &outer_edges,
@@ -239,7 +274,6 @@ BoundaryStats FloorBoundaryFinder::find(const FloorGeometry &geometry, const cv:
   prepare(inner_texture, outer_texture);
   BoundaryStats stats;
   stats.noise_scale = noise_scale_;
-  const auto margin = static_cast<float>(config_.contact_margin_px);
   const double floor_height_m = -geometry_->camera_height_m();
   points.clear();
   free_range_m.assign(static_cast<std::size_t>(inner_candidates.columns()), kNaN);
@@ -252,7 +286,6 @@ BoundaryStats FloorBoundaryFinder::find(const FloorGeometry &geometry, const cv:
     for (std::size_t index = 0; index < inner_edges_here.size(); ++index) {
       const vision::EdgePoint &edge = inner_edges_here[index];
       ++stats.edges_visited;
-      const int sign = polarity(inner_edges, edge.row, column);
       const float floor_row = geometry_->floor_outer_row_at(edge.row_subpx);
       // 1. Is there an outer edge of the same polarity where the floor puts it?
       const vision::EdgePoint *contact =
@@ -260,30 +293,15 @@ BoundaryStats FloorBoundaryFinder::find(const FloorGeometry &geometry, const cv:
       // 2. If not, the outer edge nearer than the floor that looks most alike; it explains
       //    the edge only when it fits decisively better than the floor's prediction (a
       //    floor edge whose outer twin the detector missed is not a table top).
-      const vision::EdgePoint *match = nullptr;
-      if (contact == nullptr) {
-        const DisparityBand &band = limits.per_inner_row[static_cast<std::size_t>(edge.row)];
-        const float floor_disparity = floor_row - edge.row_subpx;
-        float best_cost = std::numeric_limits<float>::infinity();
-        for (const vision::EdgePoint &outer : outer_edges_here) {
-          const float disparity = outer.row_subpx - edge.row_subpx;
-          if (!band.contains(static_cast<float>(outer.row - edge.row)) ||
-              polarity(outer_edges, outer.row, column) != sign)
-            continue;
-          if (std::isfinite(floor_disparity) && !(disparity > floor_disparity + margin)) continue;
-          const float cost = window_cost(edge.row, outer.row_subpx, column, window);
-          if (cost < best_cost) best_cost = cost, match = &outer;
-        }
-        if (match != nullptr && std::isfinite(floor_row)) {
-          const float floor_cost = window_cost(edge.row, floor_row, column, window);
-          if (kWindowCorrelation * (floor_cost - best_cost) / noise_scale_ < decision_llr_) match = nullptr;
-        }
-        if (match == nullptr && !std::isfinite(floor_row)) {
-          ++stats.unexplained;
-          if (!std::isfinite(free_end_m))
-            free_end_m = static_cast<float>(geometry_->floor_range_at(edge.row_subpx));
-          continue;
-        }
+      const vision::EdgePoint *match =
+          contact == nullptr
+              ? elevated_match(edge, column, inner_edges, outer_edges, outer_edges_here, limits, window)
+              : nullptr;
+      if (contact == nullptr && match == nullptr && !std::isfinite(floor_row)) {
+        ++stats.unexplained;
+        if (!std::isfinite(free_end_m))
+          free_end_m = static_cast<float>(geometry_->floor_range_at(edge.row_subpx));
+        continue;
       }
       if (match != nullptr) {
         const auto stereo = triangulator.triangulate(edge.row_subpx, match->row_subpx);
@@ -300,6 +318,14 @@ BoundaryStats FloorBoundaryFinder::find(const FloorGeometry &geometry, const cv:
       if (verdict == Verdict::kFloor) {
         ++stats.floor_texture;
         farthest_floor_m = static_cast<float>(geometry_->floor_range_at(edge.row_subpx));
+        continue;
+      }
+      if (contact == nullptr) {
+        // Neither lobe pair places it: a boundary needs an outer twin on the floor (or a
+        // match above it); without one the edge stays unexplained and the search goes on.
+        ++stats.unexplained;
+        if (!std::isfinite(free_end_m))
+          free_end_m = static_cast<float>(geometry_->floor_range_at(edge.row_subpx));
         continue;
       }
       // 4. Floor texture just in front of a wall leaves the wall to explain the rows above
@@ -330,6 +356,21 @@ BoundaryStats FloorBoundaryFinder::find(const FloorGeometry &geometry, const cv:
         if (!stereo) continue;
         point.range_m = stereo->range_m;
         point.height_m = stereo->height_m;
+      }
+      // 5. A table top is nearer in plan than the floor seen under it, yet higher in the
+      //    image: an edge above the floor boundary that matches decisively above the floor
+      //    and lies nearer takes its place.
+      for (std::size_t above = index + 1; above < inner_edges_here.size(); ++above) {
+        const vision::EdgePoint &high = inner_edges_here[above];
+        if (floor_contact(high, column, inner_edges, outer_edges, outer_edges_here) != nullptr) continue;
+        const vision::EdgePoint *high_match =
+            elevated_match(high, column, inner_edges, outer_edges, outer_edges_here, limits, window);
+        if (high_match == nullptr) continue;
+        const auto stereo = triangulator.triangulate(high.row_subpx, high_match->row_subpx);
+        if (stereo && stereo->range_m < point.range_m) {
+          ++stats.elevated;
+          point = {column, high.row_subpx, high_match->row_subpx, stereo->range_m, stereo->height_m, false};
+        }
       }
       points.push_back(point);
       boundary_m = static_cast<float>(point.range_m);

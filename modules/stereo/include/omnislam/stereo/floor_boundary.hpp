@@ -93,6 +93,14 @@ class FloorBoundaryFinder {
                                                        const vision::EdgeImage &inner_edges,
                                                        const vision::EdgeImage &outer_edges,
                                                        std::span<const vision::EdgePoint> outer_column) const;
+  /// The outer edge nearer than the floor that explains `edge`'s window decisively better
+  /// than the floor's prediction (an edge above the floor), or nullptr.
+  [[nodiscard]] const vision::EdgePoint *elevated_match(const vision::EdgePoint &edge, int column,
+                                                        const vision::EdgeImage &inner_edges,
+                                                        const vision::EdgeImage &outer_edges,
+                                                        std::span<const vision::EdgePoint> outer_column,
+                                                        const DisparityLimits &limits,
+                                                        const vision::EdgeSelectionConfig &window) const;
   /// Whether floor up to the farther edge and a surface standing there explain the rows
   /// beyond the nearer base better than a surface standing at the nearer base.
   [[nodiscard]] bool farther_base_explains_better(int column, float base_row, float base_contact_row,
