@@ -291,8 +291,9 @@ BoundaryStats FloorBoundaryFinder::find(const FloorGeometry &geometry, const cv:
       const vision::EdgePoint *contact =
           floor_contact(edge, column, inner_edges, outer_edges, outer_edges_here);
       // 2. If not, the outer edge nearer than the floor that looks most alike; it explains
-      //    the edge only when it fits decisively better than the floor's prediction (a
-      //    floor edge whose outer twin the detector missed is not a table top).
+      //    the edge only when it fits decisively better than the floor's prediction and any
+      //    other candidate (a floor edge whose outer twin the detector missed is not a table
+      //    top).
       const vision::EdgePoint *match =
           contact == nullptr
               ? elevated_match(edge, column, inner_edges, outer_edges, outer_edges_here, limits, window)

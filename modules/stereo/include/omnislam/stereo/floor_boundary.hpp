@@ -21,13 +21,14 @@
 ///  1. Is the edge on the floor? A floor point seen at inner row e is seen by the outer
 ///     lobe at the row the mirror model predicts from the camera height alone; an edge on
 ///     the floor has an outer edge of the same polarity there (within contact_margin_px).
-///  2. If it is not, the edge is above the floor (a table top, a shelf): it is matched by
-///     window SAD among the outer edges nearer than the floor, triangulated, and ends the
-///     search. Without a match it is left unexplained (the free range stops there).
+///  2. If it is not, the edge may be above the floor (a table top, a shelf): the outer edge
+///     nearer than the floor that explains its window decisively better than the floor's
+///     prediction and than every other candidate is triangulated and ends the search. With
+///     no such match the edge is unexplained (the free range stops there).
 ///  3. If it is, which hypothesis explains the pixels beyond it in both lobes: the floor
 ///     going on, or a vertical surface standing at the edge's range? Each row above the
 ///     edge compares the photometric residual of the two hypotheses (inner pixel against
-///     the outer pixel each predicts, after a per-row gain between the lobes), and a
+///     the outer pixel each predicts, after a radial gain model between the lobes), and a
 ///     sequential probability ratio test (Wald) accumulates them until one hypothesis wins
 ///     at the configured error rate. Floor wins: the edge is floor texture, and evidence of
 ///     free floor; the search goes on. The vertical surface wins, or the column ends
@@ -35,6 +36,10 @@
 ///     Its range is the floor range of the edge row (the floor plane is far more precise
 ///     than the stereo disparity: ~16 mm per row at 1-2 m against ~130 mm per pixel of
 ///     disparity, mirror.md sec. 9).
+///  4. Unless the next edge on the floor, as the base, explains the rows beyond better
+///     (floor texture just in front of a wall).
+///  5. And unless an edge higher up matches decisively above the floor and lies nearer in
+///     plan (a table top is nearer than the floor seen under it, yet higher in the image).
 /// The residual noise scale is measured per frame (median floor residual of the rows
 /// nearest the robot), so no threshold is in intensity units.
 
