@@ -283,13 +283,15 @@ BoundaryStats FloorBoundaryFinder::find(const FloorGeometry &geometry, const cv:
     float farthest_floor_m = kNaN;  // the farthest edge found to be floor texture
     float boundary_m = kNaN;
     const auto inner_edges_here = inner_candidates.column(column);
+    // 1. Is there an outer edge of the same polarity where the floor puts each edge? (Asked
+    //    once per edge: steps 4 and 5 ask it again of the edges above.)
+    contacts_.clear();
+    for (const vision::EdgePoint &edge : inner_edges_here)
+      contacts_.push_back(floor_contact(edge, column, inner_edges, outer_edges, outer_edges_here));
     for (std::size_t index = 0; index < inner_edges_here.size(); ++index) {
       const vision::EdgePoint &edge = inner_edges_here[index];
-      ++stats.edges_visited;
       const float floor_row = geometry_->floor_outer_row_at(edge.row_subpx);
-      // 1. Is there an outer edge of the same polarity where the floor puts it?
-      const vision::EdgePoint *contact =
-          floor_contact(edge, column, inner_edges, outer_edges, outer_edges_here);
+      const vision::EdgePoint *contact = contacts_[index];
       // 2. If not, the outer edge nearer than the floor that looks most alike; it explains
       //    the edge only when it fits decisively better than the floor's prediction and any
       //    other candidate (a floor edge whose outer twin the detector missed is not a table
@@ -308,8 +310,7 @@ BoundaryStats FloorBoundaryFinder::find(const FloorGeometry &geometry, const cv:
         const auto stereo = triangulator.triangulate(edge.row_subpx, match->row_subpx);
         if (!stereo) continue;
         ++stats.elevated;
-        points.push_back(
-            {column, edge.row_subpx, match->row_subpx, stereo->range_m, stereo->height_m, false});
+        points.push_back({column, edge.row_subpx, match->row_subpx, stereo->range_m, stereo->height_m});
         boundary_m = static_cast<float>(stereo->range_m);
         break;
       }
@@ -337,8 +338,7 @@ BoundaryStats FloorBoundaryFinder::find(const FloorGeometry &geometry, const cv:
       for (std::size_t next = index + 1; next < inner_edges_here.size(); ++next) {
         const vision::EdgePoint &farther = inner_edges_here[next];
         if (base->row - farther.row < 2 * kEdgeBlurRows) continue;
-        const vision::EdgePoint *farther_contact =
-            floor_contact(farther, column, inner_edges, outer_edges, outer_edges_here);
+        const vision::EdgePoint *farther_contact = contacts_[next];
         if (farther_contact == nullptr) break;
         if (!farther_base_explains_better(column, base->row_subpx, outer_row, farther.row_subpx,
                                           farther_contact->row_subpx))
@@ -351,7 +351,7 @@ BoundaryStats FloorBoundaryFinder::find(const FloorGeometry &geometry, const cv:
       ++stats.floor_contacts;
       if (verdict == Verdict::kUndecided) ++stats.undecided;
       const auto range_m = static_cast<float>(geometry_->floor_range_at(base->row_subpx));
-      BoundaryPoint point{column, base->row_subpx, outer_row, range_m, floor_height_m, true};
+      BoundaryPoint point{column, base->row_subpx, outer_row, range_m, floor_height_m};
       if (!config_.floor_plane_range) {
         const auto stereo = triangulator.triangulate(base->row_subpx, outer_row);
         if (!stereo) continue;
@@ -363,14 +363,14 @@ BoundaryStats FloorBoundaryFinder::find(const FloorGeometry &geometry, const cv:
       //    and lies nearer takes its place.
       for (std::size_t above = index + 1; above < inner_edges_here.size(); ++above) {
         const vision::EdgePoint &high = inner_edges_here[above];
-        if (floor_contact(high, column, inner_edges, outer_edges, outer_edges_here) != nullptr) continue;
+        if (contacts_[above] != nullptr) continue;
         const vision::EdgePoint *high_match =
             elevated_match(high, column, inner_edges, outer_edges, outer_edges_here, limits, window);
         if (high_match == nullptr) continue;
         const auto stereo = triangulator.triangulate(high.row_subpx, high_match->row_subpx);
         if (stereo && stereo->range_m < point.range_m) {
           ++stats.elevated;
-          point = {column, high.row_subpx, high_match->row_subpx, stereo->range_m, stereo->height_m, false};
+          point = {column, high.row_subpx, high_match->row_subpx, stereo->range_m, stereo->height_m};
         }
       }
       points.push_back(point);

@@ -51,12 +51,10 @@ struct BoundaryPoint {
   float inner_row = 0.0f;
   float outer_row = 0.0f;
   double range_m = 0.0;
-  double height_m = 0.0;  ///< relative to the pinhole (the floor is -camera_height_m)
-  bool on_floor = true;   ///< a floor contact (false: an edge above the floor, triangulated)
+  double height_m = 0.0;  ///< relative to the pinhole (the floor is -camera_height_m for a contact)
 };
 
 struct BoundaryStats {
-  int edges_visited = 0;
   int floor_texture = 0;     ///< edges the floor hypothesis explained
   int floor_contacts = 0;    ///< boundaries on the floor (vertical surface or undecided)
   int undecided = 0;         ///< of which the test ran out of rows
@@ -134,6 +132,7 @@ class FloorBoundaryFinder {
   float gain_at_centre_ = 1.0f;
   float gain_slope_ = 0.0f;
   std::vector<float> ratios_;
+  std::vector<const vision::EdgePoint *> contacts_;  ///< per edge of the current column
   float noise_scale_ = 0.0f;
 };
 
