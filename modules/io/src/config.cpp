@@ -12,23 +12,14 @@ namespace omnislam::io {
 namespace detail {
 
 // omnislamd's sections (service_config.cpp).
-void read_service_sections(YamlSection &top, const std::string &file, ServiceConfig &service);
+void read_service_sections(YamlSection &top, ServiceConfig &service);
 // The image degradation (degradation_section.cpp).
-void read_degradation(YamlSection &section, const std::string &file, degrade::DegradationConfig &config);
+void read_degradation(YamlSection &section, degrade::DegradationConfig &config);
 
 void read_camera_fields(YamlSection &section, mirror::MirrorConfig &camera) {
   section.read("width", camera.image_width_px);
   section.read("height", camera.image_height_px);
-  if (section.has("center_px")) {
-    const YAML::Node center = section.node("center_px");
-    if (!center.IsSequence() || center.size() != 2) section.fail("center_px", "must be [u, v] in pixels");
-    try {
-      camera.center_u_px = center[0].as<double>();
-      camera.center_v_px = center[1].as<double>();
-    } catch (const YAML::Exception &) {
-      section.fail("center_px", "must be [u, v] in pixels");
-    }
-  }
+  read_pixel_pair(section, "center_px", camera.center_u_px, camera.center_v_px);
   section.read("focal_mm", camera.focal_mm);
   section.read("pixel_pitch_mm", camera.pixel_pitch_mm);
   section.read("azimuth_offset_deg", camera.azimuth_offset_deg);
@@ -116,21 +107,20 @@ void read_stereo(YamlSection &section, stereo::StereoConfig &stereo) {
               {{"floor_boundary", stereo::BoundaryMethod::kFloorBoundary},
                {"nearest_edge", stereo::BoundaryMethod::kNearestEdge}},
               "must be floor_boundary or nearest_edge");
-  if (section.has("floor")) {
-    YamlSection floor = section.section("floor");
+  read_section(section, "floor", [&stereo](YamlSection &floor) {
     stereo::FloorBoundaryConfig &config = stereo.floor;
     floor.read("max_edges_per_column", config.max_edges_per_column);
     floor.read("contact_margin_px", config.contact_margin_px);
     floor.read("error_rate", config.error_rate);
     floor.read("floor_plane_range", config.floor_plane_range);
-    floor.finish();
     if (config.max_edges_per_column < 1 || config.max_edges_per_column > 64)
       floor.fail("max_edges_per_column", "must be 1..64");
     if (!(config.contact_margin_px > 0.0 && config.contact_margin_px <= 10.0))
       floor.fail("contact_margin_px", "must be in (0, 10]");
     if (!(config.error_rate > 0.0 && config.error_rate < 0.5))
       floor.fail("error_rate", "must be in (0, 0.5)");
-  }
+  });
+
   if (!(stereo.max_range_m > stereo.min_range_m)) section.fail("max_range_m", "must exceed min_range_m");
   if (!(stereo.far_cutoff_m > stereo.near_cutoff_m))
     section.fail("far_cutoff_m", "must exceed near_cutoff_m");
@@ -205,15 +195,15 @@ Config load_config(const std::filesystem::path &file) {
   if (!root || root.IsNull()) return config;  // an empty file keeps every default
   YamlSection top(root, "", name);
   using detail::read_section;
-  read_section(top, "camera", name, [&](YamlSection &camera) {
+  read_section(top, "camera", [&](YamlSection &camera) {
     detail::read_camera_fields(camera, config.scan.camera);
     camera.read("camera_height_m", config.scan.camera_height_m);
     if (!(config.scan.camera_height_m > 0.0)) camera.fail("camera_height_m", "must be positive");
   });
-  read_section(top, "vision", name, [&](YamlSection &vision) { read_vision(vision, config.scan.vision); });
-  read_section(top, "stereo", name, [&](YamlSection &stereo) { read_stereo(stereo, config.scan.stereo); });
-  read_section(top, "slam", name, [&](YamlSection &slam) { read_slam(slam, config.slam); });
-  read_section(top, "persistence", name, [&](YamlSection &persistence) {
+  read_section(top, "vision", [&](YamlSection &vision) { read_vision(vision, config.scan.vision); });
+  read_section(top, "stereo", [&](YamlSection &stereo) { read_stereo(stereo, config.scan.stereo); });
+  read_section(top, "slam", [&](YamlSection &slam) { read_slam(slam, config.slam); });
+  read_section(top, "persistence", [&](YamlSection &persistence) {
     persistence.read("state_dir", config.persistence.state_dir);
     persistence.read("resume", config.persistence.resume);
     persistence.read("snapshot_period_s", config.persistence.snapshot_period_s);
@@ -221,10 +211,9 @@ Config load_config(const std::filesystem::path &file) {
     read_choice(persistence, "on_corrupt_snapshot", config.persistence.refuse_corrupt_snapshot,
                 {{"start_fresh", false}, {"refuse", true}}, "must be start_fresh or refuse");
   });
-  read_section(top, "degradation", name, [&](YamlSection &degradation) {
-    detail::read_degradation(degradation, name, config.degradation);
-  });
-  detail::read_service_sections(top, name, config.service);
+  read_section(top, "degradation",
+               [&](YamlSection &degradation) { detail::read_degradation(degradation, config.degradation); });
+  detail::read_service_sections(top, config.service);
   top.finish();
   return config;
 }

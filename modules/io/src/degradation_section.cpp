@@ -10,16 +10,6 @@
 namespace omnislam::io::detail {
 namespace {
 
-// Reads the sub-mapping `key` of `section` (if present) with `read`, rejecting unknown keys;
-// errors name the full key, e.g. 'degradation.noise.full_well_e'.
-template <typename Read>
-void read_factor(YamlSection &section, const std::string &key, const std::string &file, Read &&read) {
-  if (!section.has(key)) return;
-  YamlSection factor(section.node(key), section.key_name(key), file);
-  read(factor);
-  factor.finish();
-}
-
 void require_range(YamlSection &section, const char *key, double value, double low, double high) {
   if (!(value >= low && value <= high)) {
     std::ostringstream range;
@@ -50,46 +40,37 @@ void read_dust(YamlSection &section, degrade::DustConfig &dust) {
 
 }  // namespace
 
-void read_degradation(YamlSection &section, const std::string &file, degrade::DegradationConfig &config) {
+void read_degradation(YamlSection &section, degrade::DegradationConfig &config) {
   section.read<std::uint64_t>("seed", config.seed, "a non-negative integer");
-  if (section.has("center_px")) {
-    const YAML::Node center = section.node("center_px");
-    if (!center.IsSequence() || center.size() != 2) section.fail("center_px", "must be [u, v] in pixels");
-    try {
-      config.center_u_px = center[0].as<double>();
-      config.center_v_px = center[1].as<double>();
-    } catch (const YAML::Exception &) {
-      section.fail("center_px", "must be [u, v] in pixels");
-    }
-  }
-  read_factor(section, "exposure", file, [&](YamlSection &exposure) {
+  read_pixel_pair(section, "center_px", config.center_u_px, config.center_v_px);
+  read_section(section, "exposure", [&](YamlSection &exposure) {
     exposure.read("enabled", config.exposure.enabled);
     exposure.read("max_change", config.exposure.max_change);
     if (!(config.exposure.max_change >= 0.0 && config.exposure.max_change < 1.0)) {
       exposure.fail("max_change", "must be in [0, 1)");
     }
   });
-  read_factor(section, "vignetting", file, [&](YamlSection &vignetting) {
+  read_section(section, "vignetting", [&](YamlSection &vignetting) {
     vignetting.read("enabled", config.vignetting.enabled);
     vignetting.read("rim_falloff", config.vignetting.rim_falloff);
     vignetting.read("rim_radius_px", config.vignetting.rim_radius_px);
     require_range(vignetting, "rim_falloff", config.vignetting.rim_falloff, 0.0, 1.0);
     if (!(config.vignetting.rim_radius_px > 0.0)) vignetting.fail("rim_radius_px", "must be positive");
   });
-  read_factor(section, "dust", file, [&](YamlSection &dust) { read_dust(dust, config.dust); });
-  read_factor(section, "blur", file, [&](YamlSection &blur) {
+  read_section(section, "dust", [&](YamlSection &dust) { read_dust(dust, config.dust); });
+  read_section(section, "blur", [&](YamlSection &blur) {
     blur.read("enabled", config.blur.enabled);
     blur.read("radius_px", config.blur.radius_px);
     require_range(blur, "radius_px", config.blur.radius_px, 0.0, 20.0);
   });
-  read_factor(section, "noise", file, [&](YamlSection &noise) {
+  read_section(section, "noise", [&](YamlSection &noise) {
     noise.read("enabled", config.noise.enabled);
     noise.read("full_well_e", config.noise.full_well_e);
     noise.read("read_noise_dn", config.noise.read_noise_dn);
     if (!(config.noise.full_well_e > 0.0)) noise.fail("full_well_e", "must be positive");
     if (config.noise.read_noise_dn < 0.0) noise.fail("read_noise_dn", "must be >= 0");
   });
-  read_factor(section, "jpeg", file, [&](YamlSection &jpeg) {
+  read_section(section, "jpeg", [&](YamlSection &jpeg) {
     jpeg.read("enabled", config.jpeg.enabled);
     jpeg.read("quality", config.jpeg.quality);
     if (config.jpeg.quality < 1 || config.jpeg.quality > 100) jpeg.fail("quality", "must be in 1..100");

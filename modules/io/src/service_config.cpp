@@ -66,12 +66,11 @@ void read_dds(YamlSection &section, DdsSectionConfig &dds) {
 }  // namespace
 
 // The service's sections of load_config (config.cpp), kept apart from the algorithm ones.
-void read_service_sections(YamlSection &top, const std::string &file, ServiceConfig &service) {
-  read_section(top, "input", file, [&](YamlSection &section) { read_input(section, service.input); });
-  read_section(top, "pipeline", file,
-               [&](YamlSection &section) { read_pipeline(section, service.pipeline); });
-  read_section(top, "dds", file, [&](YamlSection &section) { read_dds(section, service.dds); });
-  read_section(top, "service", file, [&](YamlSection &section) {
+void read_service_sections(YamlSection &top, ServiceConfig &service) {
+  read_section(top, "input", [&](YamlSection &section) { read_input(section, service.input); });
+  read_section(top, "pipeline", [&](YamlSection &section) { read_pipeline(section, service.pipeline); });
+  read_section(top, "dds", [&](YamlSection &section) { read_dds(section, service.dds); });
+  read_section(top, "service", [&](YamlSection &section) {
     section.read("output_dir", service.output_dir);
     section.read("stage_timeout_s", service.stage_timeout_s);
     if (!(service.stage_timeout_s > 0.0)) section.fail("stage_timeout_s", "must be positive");

@@ -88,14 +88,27 @@ class YamlSection {
   std::set<std::string> seen_;
 };
 
-/// Reads the sub-mapping `key` of `top`, if present, with `read(section)`, then rejects
-/// any key `read` did not ask for.
+/// Reads the sub-mapping `key` of `parent`, if present, with `read(section)`, then rejects
+/// any key `read` did not ask for; errors name the full key ("stereo.floor.error_rate").
 template <typename Read>
-void read_section(YamlSection &top, const std::string &key, const std::string &file, Read &&read) {
-  if (!top.has(key)) return;
-  YamlSection section(top.node(key), key, file);
+void read_section(YamlSection &parent, const std::string &key, Read &&read) {
+  if (!parent.has(key)) return;
+  YamlSection section = parent.section(key);
   read(section);
   section.finish();
+}
+
+/// A pixel position `key: [u, v]` into u and v.
+inline void read_pixel_pair(YamlSection &section, const std::string &key, double &u, double &v) {
+  if (!section.has(key)) return;
+  const YAML::Node pair = section.node(key);
+  if (!pair.IsSequence() || pair.size() != 2) section.fail(key, "must be [u, v] in pixels");
+  try {
+    u = pair[0].as<double>();
+    v = pair[1].as<double>();
+  } catch (const YAML::Exception &) {
+    section.fail(key, "must be [u, v] in pixels");
+  }
 }
 
 /// Loads a YAML file, turning parse errors into ConfigError naming file:line.
