@@ -1,7 +1,8 @@
-// bench_frontend IMAGE_OR_DATASET [--reps N] [--config FILE]: times each stage of the one-image
-// reconstruction (unwarp, Canny, edge selection, DP, triangulation) on one thread, and
-// OpenCV StereoSGBM on the same panoramas; on a dataset also reports the accuracy of both
-// against floorplan.csv (the metrics of tests/stereo/test_scan_accuracy.cpp).
+// bench_frontend IMAGE_OR_DATASET [--reps N] [--config FILE] [--no-sgbm]: times each stage of
+// the one-image reconstruction (unwarp, Canny, edge selection, matching, triangulation) on one
+// thread, and OpenCV StereoSGBM on the same panoramas (unless --no-sgbm); on a dataset also
+// reports the accuracy of both against floorplan.csv (the metrics of
+// tests/stereo/test_scan_accuracy.cpp).
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -82,11 +83,15 @@ void print_accuracy(const char *name, const Frames &frames, ScanConfig config) {
 
 int main(int argc, char **argv) {
   if (argc < 2) {
-    std::fprintf(stderr, "usage: bench_frontend IMAGE_OR_DATASET [--reps N] [--config FILE]\n");
+    std::fprintf(stderr, "usage: bench_frontend IMAGE_OR_DATASET [--reps N] [--config FILE] [--no-sgbm]\n");
     return 2;
   }
   int reps = 30;
   std::string config_file;
+  bool with_sgbm = true;
+  for (int i = 2; i < argc; ++i) {
+    if (std::string(argv[i]) == "--no-sgbm") with_sgbm = false;
+  }
   for (int i = 2; i + 1 < argc; ++i) {
     if (std::string(argv[i]) == "--reps") reps = std::max(1, std::atoi(argv[i + 1]));
     if (std::string(argv[i]) == "--config") config_file = argv[i + 1];
@@ -97,7 +102,11 @@ int main(int argc, char **argv) {
     ScanReconstructor reconstructor(frames.config);
     omnislam::bench::SgbmMatcher sgbm(reconstructor.disparity_limits());
     Samples unwarp{"unwarp (2 lobes)", {}}, canny{"Canny + fragments (2 lobes)", {}};
-    Samples select{"edge selection (2 lobes)", {}}, dp{"DP matching", {}},
+    Samples select{"edge selection (2 lobes)", {}},
+        dp{frames.config.stereo.boundary == omnislam::stereo::BoundaryMethod::kNearestEdge
+               ? "DP matching"
+               : "floor boundary search",
+           {}},
         triangulate{"triangulation + filter", {}};
     Samples total{"total (one image -> scan)", {}};
     Samples sgbm_match{"StereoSGBM (transpose, pad, match)", {}},
@@ -122,13 +131,17 @@ int main(int argc, char **argv) {
         reconstructor.triangulate(scan);
         const double t_tri = ms_since(start);
         const double t_total = std::chrono::duration<double, std::milli>(start - first).count();
-        sgbm.match(reconstructor, sgbm_matches);
-        const double t_sgbm = ms_since(start);
-        sgbm_scan_out.stats = {};
-        reconstructor.build_scan(sgbm_matches, sgbm_scan_out);
-        const double t_sgbm_scan = ms_since(start);
+        double t_sgbm = 0.0, t_sgbm_scan = 0.0;
+        if (with_sgbm) {
+          sgbm.match(reconstructor, sgbm_matches);
+          t_sgbm = ms_since(start);
+          sgbm_scan_out.stats = {};
+          reconstructor.build_scan(sgbm_matches, sgbm_scan_out);
+          t_sgbm_scan = ms_since(start);
+        }
         if (rep < 0) {
-          if (!frames.poses.empty()) sgbm_accuracy.add(sgbm_scan_out, frames.poses[i], frames.segments);
+          if (with_sgbm && !frames.poses.empty())
+            sgbm_accuracy.add(sgbm_scan_out, frames.poses[i], frames.segments);
           continue;
         }
         unwarp.ms.push_back(t_unwarp);
@@ -151,12 +164,14 @@ int main(int argc, char **argv) {
         frames.config.stereo.min_range_m, frames.config.stereo.max_range_m);
     std::printf("  %-34s %8s %8s %8s\n", "stage [ms]", "median", "p99", "max");
     for (const Samples *s : {&unwarp, &canny, &select, &dp, &triangulate, &total}) s->print();
-    std::printf("StereoSGBM on the same panoramas (min disparity %d, %d disparities, block %d):\n",
-                sgbm.min_disparity(), sgbm.num_disparities(), 5);
-    sgbm_match.print();
-    sgbm_scan.print();
-    std::printf("  %-34s %8.3f\n", "SGBM pipeline median (total - DP + SGBM)",
-                total.quantile(0.5) - dp.quantile(0.5) + sgbm_match.quantile(0.5));
+    if (with_sgbm) {
+      std::printf("StereoSGBM on the same panoramas (min disparity %d, %d disparities, block %d):\n",
+                  sgbm.min_disparity(), sgbm.num_disparities(), 5);
+      sgbm_match.print();
+      sgbm_scan.print();
+      std::printf("  %-34s %8.3f\n", "SGBM pipeline median (total - DP + SGBM)",
+                  total.quantile(0.5) - dp.quantile(0.5) + sgbm_match.quantile(0.5));
+    }
     if (!frames.poses.empty()) {
       std::printf("accuracy against floorplan.csv:\n");
       print_accuracy("floor boundary (default)", frames, frames.config);
@@ -172,7 +187,7 @@ int main(int argc, char **argv) {
       print_accuracy("DP, integer rows", frames, variant);
       variant.stereo.triangulation = omnislam::stereo::TriangulationMethod::kTable;
       print_accuracy("DP, integer rows + LUT", frames, variant);
-      std::printf("  %-28s %s\n", "StereoSGBM", sgbm_accuracy.summary().c_str());
+      if (with_sgbm) std::printf("  %-28s %s\n", "StereoSGBM", sgbm_accuracy.summary().c_str());
     }
   } catch (const std::exception &error) {
     std::fprintf(stderr, "bench_frontend: error: %s\n", error.what());

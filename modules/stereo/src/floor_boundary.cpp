@@ -74,15 +74,20 @@ void FloorBoundaryFinder::prepare(const cv::Mat &inner_texture, const cv::Mat &o
     inner_radius_squared_[static_cast<std::size_t>(row)] = radius * radius;
   }
   fit_lobe_gain();
-  floor_residual_.create(columns, rows, CV_32FC1);
-  floor_residual_.setTo(kNaN);
+  floor_gain_.resize(static_cast<std::size_t>(rows));
   for (int row = 0; row < rows; ++row) {
     const float outer_row = geometry_->floor_outer_row(row);
-    if (!std::isfinite(outer_row)) continue;
-    const float g = gain(row, outer_row);
-    for (int column = 0; column < columns; ++column) {
-      floor_residual_.ptr<float>(column)[row] =
-          std::abs(inner_px(row, column) - g * outer_at(outer_row, column));
+    floor_gain_[static_cast<std::size_t>(row)] = std::isfinite(outer_row) ? gain(row, outer_row) : kNaN;
+  }
+  floor_residual_.create(columns, rows, CV_32FC1);
+  for (int column = 0; column < columns; ++column) {  // column-major, like the textures
+    float *residual = floor_residual_.ptr<float>(column);
+    for (int row = 0; row < rows; ++row) {
+      const float g = floor_gain_[static_cast<std::size_t>(row)];
+      residual[row] =
+          std::isfinite(g)
+              ? std::abs(inner_px(row, column) - g * outer_at(geometry_->floor_outer_row(row), column))
+              : kNaN;
     }
   }
   measure_noise_scale();
@@ -124,10 +129,10 @@ void FloorBoundaryFinder::measure_noise_scale() {
   // From the rows nearest the robot, mostly floor in any room: a Laplace distribution's
   // scale is its median absolute value over ln 2 (every other row and column is plenty).
   ratios_.clear();
-  for (int row = rows / 2; row < rows; row += 2) {
-    for (int column = 0; column < columns; column += 2) {
-      const float residual = floor_residual_.ptr<float>(column)[row];
-      if (std::isfinite(residual)) ratios_.push_back(residual);
+  for (int column = 0; column < columns; column += 2) {
+    const float *residual = floor_residual_.ptr<float>(column);
+    for (int row = rows / 2; row < rows; row += 2) {
+      if (std::isfinite(residual[row])) ratios_.push_back(residual[row]);
     }
   }
   const float median = median_of(ratios_);
@@ -279,8 +284,8 @@ BoundaryStats FloorBoundaryFinder::find(const FloorGeometry &geometry, const cv:
   free_range_m.assign(static_cast<std::size_t>(inner_candidates.columns()), kNaN);
   for (int column = 0; column < inner_candidates.columns(); ++column) {
     const auto outer_edges_here = outer_candidates.column(column);
-    float free_end_m = kNaN;        // an edge off the floor that nothing explains
-    float farthest_floor_m = kNaN;  // the farthest edge found to be floor texture
+    float free_end_m = kNaN;          // an edge off the floor that nothing explains
+    float farthest_floor_row = kNaN;  // the farthest edge found to be floor texture
     float boundary_m = kNaN;
     const auto inner_edges_here = inner_candidates.column(column);
     // 1. Is there an outer edge of the same polarity where the floor puts each edge? (Asked
@@ -319,7 +324,7 @@ BoundaryStats FloorBoundaryFinder::find(const FloorGeometry &geometry, const cv:
       const Verdict verdict = floor_or_vertical(column, edge.row_subpx, outer_row);
       if (verdict == Verdict::kFloor) {
         ++stats.floor_texture;
-        farthest_floor_m = static_cast<float>(geometry_->floor_range_at(edge.row_subpx));
+        farthest_floor_row = edge.row_subpx;
         continue;
       }
       if (contact == nullptr) {
@@ -344,7 +349,7 @@ BoundaryStats FloorBoundaryFinder::find(const FloorGeometry &geometry, const cv:
                                           farther_contact->row_subpx))
           break;
         ++stats.floor_texture;
-        farthest_floor_m = static_cast<float>(geometry_->floor_range_at(base->row_subpx));
+        farthest_floor_row = base->row_subpx;
         base = &farther;
         outer_row = farther_contact->row_subpx;
       }
@@ -381,7 +386,10 @@ BoundaryStats FloorBoundaryFinder::find(const FloorGeometry &geometry, const cv:
     if (std::isfinite(boundary_m)) {
       free_m = std::isfinite(free_end_m) ? std::min(free_end_m, boundary_m) : boundary_m;
     } else {
-      free_m = std::isfinite(free_end_m) ? free_end_m : farthest_floor_m;
+      free_m = std::isfinite(free_end_m) ? free_end_m
+               : std::isfinite(farthest_floor_row)
+                   ? static_cast<float>(geometry_->floor_range_at(farthest_floor_row))
+                   : kNaN;
     }
   }
   return stats;

@@ -102,6 +102,7 @@ bool ScanReconstructor::accepts(const cv::Mat &image) const {
 }
 
 void ScanReconstructor::unwarp(const cv::Mat &image) {
+  unwarper_.prefetch(image);
   unwarper_.unwarp(image, mirror::Lobe::kInner, inner_.panorama);
   unwarper_.unwarp(image, mirror::Lobe::kOuter, outer_.panorama);
 }

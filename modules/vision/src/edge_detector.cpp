@@ -70,43 +70,43 @@ void EdgeDetector::choose_thresholds(EdgeImage &out) {
 
 void EdgeDetector::remove_fragments(EdgeImage &out) {
   // 8-connected flood fill over the (sparse) edge pixels only; much cheaper than labelling
-  // the whole image. Visited pixels are marked kVisited, then restored to 255.
+  // the whole image. A zero border of one pixel spares every bounds check; visited pixels
+  // are marked kVisited and the survivors written back as 255.
   constexpr std::uint8_t kVisited = 128;
   out.fragment_px_removed = 0;
   if (config_.min_fragment_px <= 1 || out.canny_px == 0) return;
-  cv::Mat &edges = out.edges;
-  const int rows = edges.rows, cols = edges.cols;
-  std::uint8_t *data = edges.ptr<std::uint8_t>(0);
-  const auto step = static_cast<int>(edges.step);
-  for (int row = 0; row < rows; ++row) {
-    for (int col = 0; col < cols; ++col) {
-      if (data[row * step + col] != 255) continue;
+  cv::copyMakeBorder(out.edges, padded_, 1, 1, 1, 1, cv::BORDER_CONSTANT, cv::Scalar(0));
+  std::uint8_t *data = padded_.ptr<std::uint8_t>(0);
+  const auto step = static_cast<std::ptrdiff_t>(padded_.step);
+  const std::array<std::ptrdiff_t, 8> neighbours{-step - 1, -step,    -step + 1, -1,
+                                                 1,         step - 1, step,      step + 1};
+  for (int row = 1; row <= out.edges.rows; ++row) {
+    std::uint8_t *line = padded_.ptr<std::uint8_t>(row);
+    for (int col = 1; col <= out.edges.cols; ++col) {
+      if (line[col] != 255) continue;
       component_.clear();
       stack_.clear();
-      stack_.push_back(row * step + col);
-      data[row * step + col] = kVisited;
+      stack_.push_back(line + col - data);
+      line[col] = kVisited;
       while (!stack_.empty()) {
-        const int index = stack_.back();
+        const std::ptrdiff_t index = stack_.back();
         stack_.pop_back();
         component_.push_back(index);
-        const int r = index / step, c = index % step;
-        for (int nr = std::max(0, r - 1); nr <= std::min(rows - 1, r + 1); ++nr) {
-          for (int nc = std::max(0, c - 1); nc <= std::min(cols - 1, c + 1); ++nc) {
-            std::uint8_t &pixel = data[nr * step + nc];
-            if (pixel == 255) {
-              pixel = kVisited;
-              stack_.push_back(nr * step + nc);
-            }
+        for (const std::ptrdiff_t offset : neighbours) {
+          std::uint8_t &pixel = data[index + offset];
+          if (pixel == 255) {
+            pixel = kVisited;
+            stack_.push_back(index + offset);
           }
         }
       }
       if (static_cast<int>(component_.size()) < config_.min_fragment_px) {
-        for (int index : component_) data[index] = 0;
+        for (const std::ptrdiff_t index : component_) data[index] = 0;
         out.fragment_px_removed += static_cast<int>(component_.size());
       }
     }
   }
-  cv::threshold(edges, edges, 0, 255, cv::THRESH_BINARY);
+  cv::compare(padded_(cv::Rect(1, 1, out.edges.cols, out.edges.rows)), 0, out.edges, cv::CMP_NE);
 }
 
 }  // namespace omnislam::vision

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <vector>
 
 namespace omnislam::vision {
 namespace {
@@ -11,10 +12,10 @@ int abs_row_gradient(const cv::Mat &grad_row, int row, int column) {
   return std::abs(static_cast<int>(grad_row.at<std::int16_t>(row, column)));
 }
 
-bool is_horizontal_edge(const EdgeImage &edges, int row, int column, double ratio) {
-  if (edges.edges.at<std::uint8_t>(row, column) == 0) return false;
-  const double along = std::abs(static_cast<double>(edges.grad_row.at<std::int16_t>(row, column)));
-  const double across = std::abs(static_cast<double>(edges.grad_col.at<std::int16_t>(row, column)));
+// An edge pixel whose gradient points mostly along the column.
+bool is_horizontal(std::int16_t grad_row, std::int16_t grad_col, double ratio) {
+  const double along = std::abs(static_cast<double>(grad_row));
+  const double across = std::abs(static_cast<double>(grad_col));
   return along >= ratio * across && along > 0.0;
 }
 
@@ -77,40 +78,61 @@ SelectionStats select_nearest_horizontal_edges(const EdgeImage &edges, const cv:
   const int rows = edges.edges.rows, columns = edges.edges.cols;
   const int margin = selection_margin_rows(config);
   out.reset(columns, config.max_edges_per_column);
-  for (int column = 0; column < columns; ++column) {
-    int kept = 0;
-    // Bottom-up: the bottom rows are the points nearest the robot (mirror.md sec. 0).
-    for (int row = rows - 1 - margin; row >= margin && kept < config.max_edges_per_column; --row) {
-      if (!is_horizontal_edge(edges, row, column, config.horizontal_ratio)) continue;
-      int peak = row, end = row;
-      while (end - 1 >= margin && is_horizontal_edge(edges, end - 1, column, config.horizontal_ratio)) {
-        --end;
-        if (abs_row_gradient(edges.grad_row, end, column) > abs_row_gradient(edges.grad_row, peak, column)) {
-          peak = end;
-        }
-      }
-      stats.horizontal_px += row - end + 1;
-      ++stats.runs;
-      row = end;  // the loop's --row continues above the run
-      const int above = abs_row_gradient(edges.grad_row, peak - 1, column);
-      const int centre = abs_row_gradient(edges.grad_row, peak, column);
-      const int below = abs_row_gradient(edges.grad_row, peak + 1, column);
-      if (centre < above || centre < below) {
-        ++stats.not_local_max;
-        continue;
-      }
-      if (relative_contrast(texture, peak, column, config.half_window_rows, config.half_window_columns) <
-          config.min_relative_contrast) {
-        ++stats.low_contrast;
-        continue;
-      }
-      const float offset =
-          parabola_offset(static_cast<float>(above), static_cast<float>(centre), static_cast<float>(below));
-      out.push(column, {peak, static_cast<float>(peak) + offset, static_cast<float>(centre)});
-      ++kept;
+  // Every column is read bottom-up (the bottom rows are the points nearest the robot,
+  // mirror.md sec. 0), but all columns advance together, one image row at a time: walking
+  // one column at a time would touch a new cache line per pixel.
+  constexpr int kNoRun = -1;
+  std::vector<int> run_peak(static_cast<std::size_t>(columns), kNoRun);
+  std::vector<int> kept(static_cast<std::size_t>(columns), 0);
+  // A run of consecutive horizontal edge pixels is represented by its strongest pixel
+  // (the nearest one on ties), if that is a local maximum along the column.
+  const auto close_run = [&](int column) {
+    int &peak = run_peak[static_cast<std::size_t>(column)];
+    const int above = abs_row_gradient(edges.grad_row, peak - 1, column);
+    const int centre = abs_row_gradient(edges.grad_row, peak, column);
+    const int below = abs_row_gradient(edges.grad_row, peak + 1, column);
+    const int row = peak;
+    peak = kNoRun;
+    if (centre < above || centre < below) {
+      ++stats.not_local_max;
+      return;
     }
-    stats.selected += kept;
+    if (relative_contrast(texture, row, column, config.half_window_rows, config.half_window_columns) <
+        config.min_relative_contrast) {
+      ++stats.low_contrast;
+      return;
+    }
+    const float offset =
+        parabola_offset(static_cast<float>(above), static_cast<float>(centre), static_cast<float>(below));
+    out.push(column, {row, static_cast<float>(row) + offset, static_cast<float>(centre)});
+    ++kept[static_cast<std::size_t>(column)];
+  };
+  for (int row = rows - 1 - margin; row >= margin; --row) {
+    const auto *edge = edges.edges.ptr<std::uint8_t>(row);
+    const auto *along = edges.grad_row.ptr<std::int16_t>(row);
+    const auto *across = edges.grad_col.ptr<std::int16_t>(row);
+    for (int column = 0; column < columns; ++column) {
+      int &peak = run_peak[static_cast<std::size_t>(column)];
+      const bool horizontal =
+          edge[column] != 0 && is_horizontal(along[column], across[column], config.horizontal_ratio);
+      if (!horizontal) {
+        if (peak != kNoRun) close_run(column);
+        continue;
+      }
+      if (kept[static_cast<std::size_t>(column)] >= config.max_edges_per_column) continue;
+      ++stats.horizontal_px;
+      if (peak == kNoRun) {
+        ++stats.runs;
+        peak = row;
+      } else if (std::abs(static_cast<int>(along[column])) > abs_row_gradient(edges.grad_row, peak, column)) {
+        peak = row;
+      }
+    }
   }
+  for (int column = 0; column < columns; ++column) {
+    if (run_peak[static_cast<std::size_t>(column)] != kNoRun) close_run(column);
+  }
+  for (const int count : kept) stats.selected += count;
   return stats;
 }
 

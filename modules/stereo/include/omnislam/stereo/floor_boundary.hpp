@@ -125,6 +125,7 @@ class FloorBoundaryFinder {
   cv::Mat outer_;           ///< smoothed outer texture, transposed
   cv::Mat floor_residual_;  ///< |inner - gain * outer at the floor row|, transposed like them
   std::vector<float> inner_radius_squared_;
+  std::vector<float> floor_gain_;  ///< gain() of each inner row and its floor outer row
   /// Brightness of the inner lobe over the outer lobe for the same scene point, seen at
   /// image radii r_i and r_o: reflectance ratio times radial falloff to first order,
   /// gain_at_centre_ + gain_slope_ * (r_o^2 - r_i^2) (radii in units of 512 px).

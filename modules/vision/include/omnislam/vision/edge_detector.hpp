@@ -1,5 +1,6 @@
 #pragma once
 
+#include <cstddef>
 #include <opencv2/core.hpp>
 #include <vector>
 
@@ -41,8 +42,9 @@ class EdgeDetector {
   CannyConfig config_;
   cv::Size kernel_size_;
   cv::Mat smoothed_;
-  std::vector<int> stack_;  ///< flood-fill scratch (pixel indices)
-  std::vector<int> component_;
+  cv::Mat padded_;                     ///< edges with a zero border, for the flood fill
+  std::vector<std::ptrdiff_t> stack_;  ///< flood-fill scratch (offsets into padded_)
+  std::vector<std::ptrdiff_t> component_;
 };
 
 }  // namespace omnislam::vision

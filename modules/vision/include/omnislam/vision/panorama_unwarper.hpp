@@ -21,6 +21,11 @@ class PanoramaUnwarper {
   /// `panorama` is reallocated only when its size or type differ.
   void unwarp(const cv::Mat &image, mirror::Lobe lobe, cv::Mat &panorama) const;
 
+  /// Reads one byte per cache line of the image rows both lobes sample, in raster order.
+  /// A fresh frame is usually not in cache, and remap's arcs defeat the hardware prefetcher;
+  /// one streaming pass first makes both unwarps read from cache (2-3x faster on a new frame).
+  void prefetch(const cv::Mat &image) const;
+
   [[nodiscard]] int rows() const { return rows_; }
   [[nodiscard]] int columns() const { return columns_; }
 
@@ -31,6 +36,8 @@ class PanoramaUnwarper {
   };
   int rows_ = 0;
   int columns_ = 0;
+  int first_row_ = 0;  ///< image rows any lobe sample touches: [first_row_, last_row_]
+  int last_row_ = -1;
   Maps inner_;
   Maps outer_;
 };
