@@ -74,6 +74,33 @@ TEST_CASE("Canny thresholds: automatic choice has a floor, fixed ones are used a
   CHECK(fixed.canny_px == 0);
 }
 
+TEST_CASE("edges are cv::Canny's (L2) on a textured, noisy panorama and on the convention image",
+          "[vision][canny]") {
+  cv::Mat textured(225, 360, CV_8UC1);
+  cv::RNG rng(7);
+  rng.fill(textured, cv::RNG::UNIFORM, 0, 256);
+  cv::GaussianBlur(textured, textured, cv::Size(5, 5), 1.5);  // tile-sized blobs, not pure noise
+  cv::Mat noise(textured.size(), CV_8UC1);
+  rng.fill(noise, cv::RNG::NORMAL, 0, 6);
+  cv::add(textured, noise, textured);
+  cv::rectangle(textured, cv::Rect(0, 120, 360, 105), cv::Scalar(40), cv::FILLED);  // a long step
+  cv::Mat convention;
+  PanoramaUnwarper(MirrorModel{})
+      .unwarp(cv::imread(kConventionImage, cv::IMREAD_GRAYSCALE), Lobe::kInner, convention);
+  CannyConfig config;
+  config.min_fragment_px = 0;  // Canny's own output
+  for (const cv::Mat &panorama : {textured, convention}) {
+    EdgeImage edges;
+    EdgeDetector(config).detect(panorama, edges);
+    cv::Mat expected, differ;
+    cv::Canny(edges.grad_col, edges.grad_row, expected, edges.low_threshold, edges.high_threshold, true);
+    cv::compare(expected, edges.edges, differ, cv::CMP_NE);
+    CHECK(cv::countNonZero(expected) > 1000);
+    CHECK(edges.canny_px == cv::countNonZero(expected));
+    CHECK(cv::countNonZero(differ) == 0);
+  }
+}
+
 TEST_CASE("tiny edge fragments are removed, long edges kept", "[vision][canny]") {
   cv::Mat pano(225, 360, CV_8UC1, cv::Scalar(100));
   cv::rectangle(pano, cv::Rect(50, 100, 2, 2), cv::Scalar(220), cv::FILLED);   // a speck

@@ -12,6 +12,19 @@ namespace {
 // Sobel 3x3 on 8-bit input: |g| <= 4 * 255 * sqrt(2) < 1443.
 constexpr int kMagnitudeBins = 1448;
 
+// Pixel states of the padded edge map.
+constexpr std::uint8_t kNotEdge = 0;
+constexpr std::uint8_t kCandidate = 1;  // a local maximum between the thresholds
+constexpr std::uint8_t kVisited = 128;  // an edge pixel already assigned to a fragment
+constexpr std::uint8_t kEdge = 255;
+
+// tan(22.5 deg) in Q15: the gradient points within 22.5 deg of the column axis when
+// |g_row| < tan(22.5) |g_col|, of the row axis when |g_row| > tan(67.5) |g_col|, and
+// tan(67.5) = tan(22.5) + 2.
+constexpr int kTan22Q15 = 13573;
+constexpr int kQ15 = 1 << 15;
+constexpr double kMaxThreshold = 32767.0;
+
 }  // namespace
 
 EdgeDetector::EdgeDetector(const CannyConfig &config) : config_(config) {
@@ -30,9 +43,88 @@ void EdgeDetector::detect(const cv::Mat &panorama, EdgeImage &out) {
   }
   cv::spatialGradient(smoothed_, out.grad_col, out.grad_row, 3, cv::BORDER_REPLICATE);  // Sobel 3x3
   choose_thresholds(out);
-  cv::Canny(out.grad_col, out.grad_row, out.edges, out.low_threshold, out.high_threshold, true);
-  out.canny_px = cv::countNonZero(out.edges);
+  suppress_non_maxima(out);
+  out.canny_px = trace_hysteresis();
   remove_fragments(out);
+}
+
+void EdgeDetector::suppress_non_maxima(const EdgeImage &out) {
+  // Canny on the L2 magnitude, as cv::Canny(dx, dy, ..., L2gradient = true) defines it, on
+  // squared magnitudes in integers (the thresholds squared and floored: m > floor(t^2) is
+  // sqrt(m) > t for an integer m). Both maps carry a border of one zero pixel, so no
+  // neighbour needs a bounds check and the border never joins an edge.
+  const int rows = out.grad_row.rows, columns = out.grad_row.cols;
+  magnitude_.create(rows + 2, columns + 2, CV_32SC1);
+  magnitude_.setTo(0);
+  for (int row = 0; row < rows; ++row) {
+    const auto *gr = out.grad_row.ptr<std::int16_t>(row);
+    const auto *gc = out.grad_col.ptr<std::int16_t>(row);
+    std::int32_t *m = magnitude_.ptr<std::int32_t>(row + 1) + 1;
+    for (int col = 0; col < columns; ++col) m[col] = gr[col] * gr[col] + gc[col] * gc[col];
+  }
+  // Thresholds beyond any magnitude are capped (as cv::Canny does) so that squares fit.
+  const double low_capped = std::min(out.low_threshold, kMaxThreshold);
+  const double high_capped = std::min(out.high_threshold, kMaxThreshold);
+  const auto low = static_cast<std::int32_t>(std::floor(low_capped * low_capped));
+  const auto high = static_cast<std::int32_t>(std::floor(high_capped * high_capped));
+  state_.create(rows + 2, columns + 2, CV_8UC1);
+  state_.setTo(kNotEdge);
+  // Branch-free: about half the pixels of a textured floor pass the low threshold, at
+  // random, and a branch per test would be mispredicted that often.
+  // Each pixel enters the trace at most once: one slot per pixel, allocated once per size.
+  trace_.resize(static_cast<std::size_t>(rows) * static_cast<std::size_t>(columns));
+  std::size_t strong = 0;
+  const std::uint8_t *origin = state_.ptr<std::uint8_t>(0);
+  const auto step = static_cast<std::ptrdiff_t>(magnitude_.step1());
+  for (int row = 0; row < rows; ++row) {
+    const auto *gr = out.grad_row.ptr<std::int16_t>(row);
+    const auto *gc = out.grad_col.ptr<std::int16_t>(row);
+    const std::int32_t *m = magnitude_.ptr<std::int32_t>(row + 1) + 1;
+    std::uint8_t *state = state_.ptr<std::uint8_t>(row + 1) + 1;
+    const std::ptrdiff_t first = state - origin;
+    for (int col = 0; col < columns; ++col) {
+      const int across = std::abs(static_cast<int>(gc[col])), along = std::abs(static_cast<int>(gr[col]));
+      const int tan22 = across * kTan22Q15, scaled = along * kQ15;
+      // The two neighbours along the gradient: left and right, above and below, or a
+      // diagonal pair. On a plateau along a row or a column its first pixel survives, along
+      // a diagonal none does (cv::Canny's rule, kept so that the edges are the same).
+      const bool along_row = scaled < tan22;
+      const bool along_column = scaled > tan22 + 2 * across * kQ15;
+      const std::ptrdiff_t diagonal = (gr[col] < 0) != (gc[col] < 0) ? step - 1 : step + 1;
+      const std::ptrdiff_t offset = along_row ? 1 : along_column ? step : diagonal;
+      const int strict = static_cast<int>(!along_row && !along_column);
+      const std::int32_t here = m[col];
+      const int maximum = static_cast<int>(here > low) & static_cast<int>(here > m[col - offset]) &
+                          static_cast<int>(here >= m[col + offset] + strict);
+      const int edge = maximum & static_cast<int>(here > high);
+      state[col] = static_cast<std::uint8_t>(maximum * kCandidate + edge * (kEdge - kCandidate));
+      trace_[strong] = first + col;
+      strong += static_cast<std::size_t>(edge);
+    }
+  }
+  trace_top_ = strong;
+}
+
+int EdgeDetector::trace_hysteresis() {
+  // Every candidate 8-connected to an edge pixel becomes one (trace_ holds, as a stack, the
+  // edges whose neighbours are still to visit).
+  std::uint8_t *data = state_.ptr<std::uint8_t>(0);
+  const auto step = static_cast<std::ptrdiff_t>(state_.step);
+  const std::array<std::ptrdiff_t, 8> neighbours{-step - 1, -step,    -step + 1, -1,
+                                                 1,         step - 1, step,      step + 1};
+  auto edges = static_cast<int>(trace_top_);
+  while (trace_top_ > 0) {
+    const std::ptrdiff_t index = trace_[--trace_top_];
+    for (const std::ptrdiff_t offset : neighbours) {
+      std::uint8_t &pixel = data[index + offset];
+      if (pixel == kCandidate) {
+        pixel = kEdge;
+        trace_[trace_top_++] = index + offset;
+        ++edges;
+      }
+    }
+  }
+  return edges;
 }
 
 void EdgeDetector::choose_thresholds(EdgeImage &out) {
@@ -69,21 +161,23 @@ void EdgeDetector::choose_thresholds(EdgeImage &out) {
 }
 
 void EdgeDetector::remove_fragments(EdgeImage &out) {
-  // 8-connected flood fill over the (sparse) edge pixels only; much cheaper than labelling
-  // the whole image. A zero border of one pixel spares every bounds check; visited pixels
-  // are marked kVisited and the survivors written back as 255.
-  constexpr std::uint8_t kVisited = 128;
+  // 8-connected flood fill over the (sparse) edge pixels of the padded map; much cheaper
+  // than labelling the whole image. Pixels of fragments kept become kVisited, the others
+  // kNotEdge.
+  const cv::Rect interior(1, 1, out.grad_row.cols, out.grad_row.rows);
   out.fragment_px_removed = 0;
-  if (config_.min_fragment_px <= 1 || out.canny_px == 0) return;
-  cv::copyMakeBorder(out.edges, padded_, 1, 1, 1, 1, cv::BORDER_CONSTANT, cv::Scalar(0));
-  std::uint8_t *data = padded_.ptr<std::uint8_t>(0);
-  const auto step = static_cast<std::ptrdiff_t>(padded_.step);
+  if (config_.min_fragment_px <= 1 || out.canny_px == 0) {
+    cv::compare(state_(interior), kEdge, out.edges, cv::CMP_EQ);
+    return;
+  }
+  std::uint8_t *data = state_.ptr<std::uint8_t>(0);
+  const auto step = static_cast<std::ptrdiff_t>(state_.step);
   const std::array<std::ptrdiff_t, 8> neighbours{-step - 1, -step,    -step + 1, -1,
                                                  1,         step - 1, step,      step + 1};
-  for (int row = 1; row <= out.edges.rows; ++row) {
-    std::uint8_t *line = padded_.ptr<std::uint8_t>(row);
-    for (int col = 1; col <= out.edges.cols; ++col) {
-      if (line[col] != 255) continue;
+  for (int row = 1; row <= interior.height; ++row) {
+    std::uint8_t *line = state_.ptr<std::uint8_t>(row);
+    for (int col = 1; col <= interior.width; ++col) {
+      if (line[col] != kEdge) continue;
       component_.clear();
       stack_.clear();
       stack_.push_back(line + col - data);
@@ -94,19 +188,19 @@ void EdgeDetector::remove_fragments(EdgeImage &out) {
         component_.push_back(index);
         for (const std::ptrdiff_t offset : neighbours) {
           std::uint8_t &pixel = data[index + offset];
-          if (pixel == 255) {
+          if (pixel == kEdge) {
             pixel = kVisited;
             stack_.push_back(index + offset);
           }
         }
       }
       if (static_cast<int>(component_.size()) < config_.min_fragment_px) {
-        for (const std::ptrdiff_t index : component_) data[index] = 0;
+        for (const std::ptrdiff_t index : component_) data[index] = kNotEdge;
         out.fragment_px_removed += static_cast<int>(component_.size());
       }
     }
   }
-  cv::compare(padded_(cv::Rect(1, 1, out.edges.cols, out.edges.rows)), 0, out.edges, cv::CMP_NE);
+  cv::compare(state_(interior), kVisited, out.edges, cv::CMP_EQ);
 }
 
 }  // namespace omnislam::vision

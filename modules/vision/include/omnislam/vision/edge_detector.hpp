@@ -8,7 +8,8 @@
 
 /// @file
 /// Canny edges of one panorama (thesis sec. 3 step 2): Gaussian smoothing, Sobel gradient,
-/// OpenCV's hysteresis on the L2 magnitude, then removal of tiny edge fragments.
+/// non-maximum suppression and hysteresis on the L2 magnitude (cv::Canny's definition, on
+/// integers, fused with the next step), then removal of tiny edge fragments.
 
 namespace omnislam::vision {
 
@@ -37,13 +38,21 @@ class EdgeDetector {
 
  private:
   void choose_thresholds(EdgeImage &out);
+  /// Local maxima of the gradient magnitude along its direction into state_: edges above
+  /// the high threshold (also pushed on trace_), candidates above the low one.
+  void suppress_non_maxima(const EdgeImage &out);
+  /// Hysteresis: candidates connected to edges become edges. Returns the edge pixels.
+  int trace_hysteresis();
   void remove_fragments(EdgeImage &out);
 
   CannyConfig config_;
   cv::Size kernel_size_;
   cv::Mat smoothed_;
-  cv::Mat padded_;                     ///< edges with a zero border, for the flood fill
-  std::vector<std::ptrdiff_t> stack_;  ///< flood-fill scratch (offsets into padded_)
+  cv::Mat magnitude_;                  ///< squared gradient magnitude, zero border of one pixel
+  cv::Mat state_;                      ///< edge map with the same border (kNotEdge ... kEdge)
+  std::vector<std::ptrdiff_t> trace_;  ///< hysteresis stack, one slot per pixel (offsets into state_)
+  std::size_t trace_top_ = 0;
+  std::vector<std::ptrdiff_t> stack_;  ///< flood-fill scratch (offsets into state_)
   std::vector<std::ptrdiff_t> component_;
 };
 
