@@ -1,8 +1,10 @@
-// bench_frontend IMAGE_OR_DATASET [--reps N] [--config FILE] [--no-sgbm]: times each stage of
-// the one-image reconstruction (unwarp, Canny, edge selection, matching, triangulation) on one
-// thread, and OpenCV StereoSGBM on the same panoramas (unless --no-sgbm); on a dataset also
-// reports the accuracy of both against floorplan.csv (the metrics of
-// tests/stereo/test_scan_accuracy.cpp).
+// bench_frontend IMAGE_OR_DATASET [--reps N] [--config FILE] [--no-sgbm] [--degrade LIST]
+//                [--degrade-seed N]: times each stage of the one-image reconstruction (unwarp,
+// Canny, edge selection, matching, triangulation) on one thread, and OpenCV StereoSGBM on the
+// same panoramas (unless --no-sgbm); on a dataset also reports the accuracy of both against
+// floorplan.csv (the metrics of tests/stereo/test_scan_accuracy.cpp). --degrade applies the
+// degradation stage once at load (frame n gets frame number n, as replay --degrade does), with
+// the config file's degradation parameters.
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -10,9 +12,12 @@
 #include <exception>
 #include <filesystem>
 #include <opencv2/core.hpp>
+#include <optional>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
+#include "omnislam/degrade/degradation.hpp"
 #include "omnislam/io/config.hpp"
 #include "omnislam/io/image_file.hpp"
 #include "omnislam/stereo/scan_reconstructor.hpp"
@@ -54,9 +59,37 @@ struct Frames {
   ScanConfig config;
 };
 
-Frames load(const std::filesystem::path &input, const std::string &config_file) {
+struct Options {
+  int reps = 30;
+  std::string config_file;
+  bool with_sgbm = true;
+  std::string degrade = "none";
+  std::optional<std::uint64_t> degrade_seed;
+};
+
+void degrade(const Options &options, omnislam::degrade::DegradationConfig parameters,
+             std::vector<cv::Mat> &images) {
+  if (const std::string error = omnislam::degrade::apply_factor_list(options.degrade, parameters);
+      !error.empty())
+    throw std::invalid_argument("--degrade: " + error);
+  if (options.degrade_seed) parameters.seed = *options.degrade_seed;
+  if (images.empty() || omnislam::degrade::enabled_factors(parameters) == "none") return;
+  const omnislam::degrade::Degrader degrader(parameters, images.front().size());
+  for (std::size_t i = 0; i < images.size(); ++i) {
+    omnislam::degrade::Degraded result = degrader.apply(images[i], static_cast<int>(i) + 1);
+    if (!result.ok()) throw std::runtime_error("frame " + std::to_string(i + 1) + ": " + result.error);
+    images[i] = result.image;
+  }
+}
+
+Frames load(const std::filesystem::path &input, const Options &options) {
   Frames frames;
-  if (!config_file.empty()) frames.config = omnislam::io::load_config(config_file).scan;
+  omnislam::degrade::DegradationConfig degradation;
+  if (!options.config_file.empty()) {
+    const omnislam::io::Config config = omnislam::io::load_config(options.config_file);
+    frames.config = config.scan;
+    degradation = config.degradation;
+  }
   if (std::filesystem::is_directory(input)) {
     omnislam::test::TruthDataset data = omnislam::test::load_truth_dataset(input);
     frames.images = std::move(data.images);
@@ -67,6 +100,7 @@ Frames load(const std::filesystem::path &input, const std::string &config_file) 
   } else {
     frames.images.push_back(omnislam::io::read_camera_image(input, frames.config.camera));
   }
+  degrade(options, degradation, frames.images);
   return frames;
 }
 
@@ -83,22 +117,26 @@ void print_accuracy(const char *name, const Frames &frames, ScanConfig config) {
 
 int main(int argc, char **argv) {
   if (argc < 2) {
-    std::fprintf(stderr, "usage: bench_frontend IMAGE_OR_DATASET [--reps N] [--config FILE] [--no-sgbm]\n");
+    std::fprintf(stderr,
+                 "usage: bench_frontend IMAGE_OR_DATASET [--reps N] [--config FILE] [--no-sgbm] "
+                 "[--degrade LIST] [--degrade-seed N]\n");
     return 2;
   }
-  int reps = 30;
-  std::string config_file;
-  bool with_sgbm = true;
+  Options options;
   for (int i = 2; i < argc; ++i) {
-    if (std::string(argv[i]) == "--no-sgbm") with_sgbm = false;
+    const std::string arg = argv[i];
+    if (arg == "--no-sgbm") options.with_sgbm = false;
+    if (i + 1 >= argc) continue;
+    if (arg == "--reps") options.reps = std::max(1, std::atoi(argv[i + 1]));
+    if (arg == "--config") options.config_file = argv[i + 1];
+    if (arg == "--degrade") options.degrade = argv[i + 1];
+    if (arg == "--degrade-seed") options.degrade_seed = std::strtoull(argv[i + 1], nullptr, 10);
   }
-  for (int i = 2; i + 1 < argc; ++i) {
-    if (std::string(argv[i]) == "--reps") reps = std::max(1, std::atoi(argv[i + 1]));
-    if (std::string(argv[i]) == "--config") config_file = argv[i + 1];
-  }
+  const int reps = options.reps;
+  const bool with_sgbm = options.with_sgbm;
   try {
     cv::setNumThreads(1);
-    const Frames frames = load(argv[1], config_file);
+    const Frames frames = load(argv[1], options);
     ScanReconstructor reconstructor(frames.config);
     omnislam::bench::SgbmMatcher sgbm(reconstructor.disparity_limits());
     Samples unwarp{"unwarp (2 lobes)", {}}, canny{"Canny + fragments (2 lobes)", {}};
@@ -155,8 +193,8 @@ int main(int argc, char **argv) {
       }
     }
     const auto &limits = reconstructor.disparity_limits();
-    std::printf("bench_frontend %s: %zu frame(s) x %d repetitions, one thread\n", argv[1],
-                frames.images.size(), reps);
+    std::printf("bench_frontend %s: %zu frame(s) x %d repetitions, one thread, degradation: %s\n", argv[1],
+                frames.images.size(), reps, options.degrade.c_str());
     std::printf(
         "disparity band from the mirror model: %.2f..%.2f px over all inner rows "
         "(camera %.2f m up, search %.2f..%.2f m)\n",
