@@ -155,6 +155,26 @@ float FloorBoundaryFinder::window_cost(int inner_row, float outer_row, int colum
   return sum;
 }
 
+float FloorBoundaryFinder::window_deviation(int inner_row, int column,
+                                            const vision::EdgeSelectionConfig &window) const {
+  const int rows = rows_, columns = inner_.rows;
+  const auto pixel = [&](int dr, int dc) {
+    return inner_px(std::clamp(inner_row + dr, 0, rows - 1), (column + dc + columns) % columns);
+  };
+  float sum = 0.0f, count = 0.0f;
+  for (int dc = -window.half_window_columns; dc <= window.half_window_columns; ++dc) {
+    for (int dr = -window.half_window_rows; dr <= window.half_window_rows; ++dr)
+      sum += pixel(dr, dc), count += 1.0f;
+  }
+  const float mean = sum / count;
+  float deviation = 0.0f;
+  for (int dc = -window.half_window_columns; dc <= window.half_window_columns; ++dc) {
+    for (int dr = -window.half_window_rows; dr <= window.half_window_rows; ++dr)
+      deviation += std::abs(pixel(dr, dc) - mean);
+  }
+  return deviation;
+}
+
 float FloorBoundaryFinder::row_vote(float residual_against, float residual_for) const {
   const float difference = (residual_against - residual_for) / noise_scale_;
   return std::clamp(std::copysign(std::max(0.0f, std::abs(difference) - kDeadZone), difference), -kMaxRowVote,
@@ -234,7 +254,8 @@ bool FloorBoundaryFinder::farther_base_explains_better(int column, float base_ro
 const vision::EdgePoint *FloorBoundaryFinder::elevated_match(
     const vision::EdgePoint &edge, int column, const vision::EdgeImage &inner_edges,
     const vision::EdgeImage &outer_edges, std::span<const vision::EdgePoint> outer_column,
-    const DisparityLimits &limits, const vision::EdgeSelectionConfig &window) const {
+    const DisparityLimits &limits, const vision::EdgeSelectionConfig &window, float standing_outer_row,
+    float floor_seen_outer_row) const {
   const DisparityBand &band = limits.per_inner_row[static_cast<std::size_t>(edge.row)];
   const float floor_row = geometry_->floor_outer_row_at(edge.row_subpx);
   const float floor_disparity = floor_row - edge.row_subpx;
@@ -248,6 +269,7 @@ const vision::EdgePoint *FloorBoundaryFinder::elevated_match(
         polarity(outer_edges, outer.row, column) != sign)
       continue;
     if (std::isfinite(floor_disparity) && !(disparity > floor_disparity + margin)) continue;
+    if (!(outer.row_subpx < floor_seen_outer_row - static_cast<float>(kEdgeBlurRows))) continue;
     const float cost = window_cost(edge.row, outer.row_subpx, column, window);
     if (cost < best_cost) {
       second_cost = best_cost, best_cost = cost, match = &outer;
@@ -262,8 +284,20 @@ const vision::EdgePoint *FloorBoundaryFinder::elevated_match(
            kWindowCorrelation * (other_cost - best_cost) / noise_scale_ >= decision_llr_;
   };
   if (match == nullptr || !decisive(second_cost)) return nullptr;
+  // ... and than a featureless patch of the window's mean brightness: a match must explain
+  // the window's structure (a speck on one mirror lobe has no twin, and the nearest edge of
+  // the same polarity fits it hardly better than nothing).
+  if (!decisive(window_deviation(edge.row, column, window))) return nullptr;
   if (std::isfinite(floor_row) && !decisive(window_cost(edge.row, floor_row, column, window))) return nullptr;
+  if (std::isfinite(standing_outer_row) &&
+      !decisive(window_cost(edge.row, standing_outer_row, column, window)))
+    return nullptr;
   return match;
+}
+
+float FloorBoundaryFinder::floor_seen_outer_row(float farthest_floor_row) const {
+  const float row = geometry_->floor_outer_row_at(farthest_floor_row);
+  return std::isfinite(row) ? row : std::numeric_limits<float>::infinity();
 }
 
 BoundaryStats FloorBoundaryFinder::find(const FloorGeometry &geometry, const cv::Mat &inner_texture,
@@ -302,9 +336,9 @@ BoundaryStats FloorBoundaryFinder::find(const FloorGeometry &geometry, const cv:
       //    other candidate (a floor edge whose outer twin the detector missed is not a table
       //    top).
       const vision::EdgePoint *match =
-          contact == nullptr
-              ? elevated_match(edge, column, inner_edges, outer_edges, outer_edges_here, limits, window)
-              : nullptr;
+          contact == nullptr ? elevated_match(edge, column, inner_edges, outer_edges, outer_edges_here,
+                                              limits, window, kNaN, floor_seen_outer_row(farthest_floor_row))
+                             : nullptr;
       if (contact == nullptr && match == nullptr && !std::isfinite(floor_row)) {
         ++stats.unexplained;
         if (!std::isfinite(free_end_m))
@@ -369,8 +403,11 @@ BoundaryStats FloorBoundaryFinder::find(const FloorGeometry &geometry, const cv:
       for (std::size_t above = index + 1; above < inner_edges_here.size(); ++above) {
         const vision::EdgePoint &high = inner_edges_here[above];
         if (contacts_[above] != nullptr) continue;
+        // Decisively better, too, than the surface standing at the boundary: an edge on
+        // that wall (a picture, a door frame) whose outer twin was missed is not a table.
         const vision::EdgePoint *high_match =
-            elevated_match(high, column, inner_edges, outer_edges, outer_edges_here, limits, window);
+            elevated_match(high, column, inner_edges, outer_edges, outer_edges_here, limits, window,
+                           geometry_->vertical_outer_row_at(high.row, base->row_subpx), outer_row);
         if (high_match == nullptr) continue;
         const auto stereo = triangulator.triangulate(high.row_subpx, high_match->row_subpx);
         if (stereo && stereo->range_m < point.range_m) {

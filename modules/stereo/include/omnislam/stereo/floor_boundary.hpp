@@ -97,13 +97,19 @@ class FloorBoundaryFinder {
                                                        const vision::EdgeImage &outer_edges,
                                                        std::span<const vision::EdgePoint> outer_column) const;
   /// The outer edge nearer than the floor that explains `edge`'s window decisively better
-  /// than the floor's prediction (an edge above the floor), or nullptr.
-  [[nodiscard]] const vision::EdgePoint *elevated_match(const vision::EdgePoint &edge, int column,
-                                                        const vision::EdgeImage &inner_edges,
-                                                        const vision::EdgeImage &outer_edges,
-                                                        std::span<const vision::EdgePoint> outer_column,
-                                                        const DisparityLimits &limits,
-                                                        const vision::EdgeSelectionConfig &window) const;
+  /// than the floor's prediction (an edge above the floor), or nullptr. If
+  /// `standing_outer_row` is finite (the row a surface standing at the boundary puts the
+  /// edge at), decisively better than that too. Only outer edges above
+  /// `floor_seen_outer_row` are candidates: below it the outer lobe shows floor the column
+  /// has already verified, and one pixel does not show two things.
+  [[nodiscard]] const vision::EdgePoint *elevated_match(
+      const vision::EdgePoint &edge, int column, const vision::EdgeImage &inner_edges,
+      const vision::EdgeImage &outer_edges, std::span<const vision::EdgePoint> outer_column,
+      const DisparityLimits &limits, const vision::EdgeSelectionConfig &window, float standing_outer_row,
+      float floor_seen_outer_row) const;
+  /// The outer row from which on (downwards) the outer lobe shows floor already verified in
+  /// this column: the floor row of the farthest floor-texture edge (+inf when there is none).
+  [[nodiscard]] float floor_seen_outer_row(float farthest_floor_row) const;
   /// Whether floor up to the farther edge and a surface standing there explain the rows
   /// beyond the nearer base better than a surface standing at the nearer base.
   [[nodiscard]] bool farther_base_explains_better(int column, float base_row, float base_contact_row,
@@ -115,6 +121,9 @@ class FloorBoundaryFinder {
   /// `outer_row` (fractional), on the smoothed textures.
   [[nodiscard]] float window_cost(int inner_row, float outer_row, int column,
                                   const vision::EdgeSelectionConfig &window) const;
+  /// SAD of the inner window against its own mean: the cost of explaining it by nothing.
+  [[nodiscard]] float window_deviation(int inner_row, int column,
+                                       const vision::EdgeSelectionConfig &window) const;
 
   const FloorGeometry *geometry_ = nullptr;  ///< of the current find() call
   FloorBoundaryConfig config_;
