@@ -63,8 +63,8 @@ TEST_CASE("sim-room-37: local scans against the floor plan", "[stereo][accuracy]
 }
 
 // Tiled floor, soft shadows, sunlight; then every sensor factor on top. Measured when
-// written: noise-free 0.21% / 94.0% within 0.1 m / coverage 89.7%; degraded 0.27% / 93.4% /
-// 85.3% (the issue: median <= 2%, >= 90% within 0.1 m).
+// written: noise-free 0.19% / 95.2% within 0.1 m / coverage 89.7%; degraded 0.24% / 95.0% /
+// 85.0% (the issue: median <= 2%, >= 90% within 0.1 m).
 TEST_CASE("sim-room-37-real: local scans against the floor plan", "[stereo][accuracy][dataset]") {
   const omnislam::test::ScanAccuracy clean = scan_accuracy("sim-room-37-real", 37, false);
   CHECK(clean.median_relative_error() <= 0.02);
@@ -81,30 +81,31 @@ TEST_CASE("sim-room-37-real: local scans against the floor plan", "[stereo][accu
 }
 
 // The office: hexagon carpet, a pillar, furniture, camera 0.8 m up, robot facing its travel.
-// Measured when written: noise-free 0.33% / 87.1% within 0.1 m / coverage 88.2%; degraded
-// 0.44% / 81.3% / 84.1% (the issue asks >= 90% within 0.1 m: not yet held here; one cause
-// seen: table tops whose edge is missed, so the boundary lands on the floor behind them).
+// Measured when written: noise-free 0.29% / 90.8% within 0.1 m / coverage 87.1%; degraded
+// 0.36% / 86.1% / 82.1% (the issue asks >= 90% within 0.1 m: not yet held degraded; causes
+// seen: carpet edges whose outer twin is found a pixel off the floor's row, taken for a
+// low obstacle, and table tops whose edge is missed, so the boundary lands behind them).
 TEST_CASE("office-real: local scans against the floor plan", "[stereo][accuracy][dataset]") {
   const omnislam::test::ScanAccuracy clean = scan_accuracy("office-real", 45, false);
   CHECK(clean.median_relative_error() <= 0.02);
-  CHECK(clean.near_segment_share() >= 0.83);
+  CHECK(clean.near_segment_share() >= 0.90);
   CHECK(clean.coverage() >= 0.85);
   const omnislam::test::ScanAccuracy degraded = scan_accuracy("office-real", 45, true);
   CHECK(degraded.median_relative_error() <= 0.02);
-  CHECK(degraded.near_segment_share() >= 0.80);
-  CHECK(degraded.coverage() >= 0.82);
+  CHECK(degraded.near_segment_share() >= 0.84);
+  CHECK(degraded.coverage() >= 0.80);
   CHECK(degraded.free_known_share() >= 0.90);
   CHECK(degraded.free_overclaim_share() <= 0.15);
 }
 
 // The L-room with oak planks, a rug, pendant lamps over the tables and sunlight. Measured
-// when written: noise-free 0.66% / 88.3% within 0.1 m / coverage 84.6%; degraded 0.80% /
-// 86.6% / 82.1% (the issue asks >= 90% within 0.1 m: not yet held here).
+// when written: noise-free 0.55% / 95.0% within 0.1 m / coverage 84.4%; degraded 0.65% /
+// 93.3% / 81.6%.
 TEST_CASE("l-room-1lap-real: local scans against the floor plan", "[stereo][accuracy][dataset]") {
   const omnislam::test::ScanAccuracy degraded = scan_accuracy("l-room-1lap-real", 60, true);
   CHECK(degraded.median_relative_error() <= 0.02);
-  CHECK(degraded.near_segment_share() >= 0.84);
-  CHECK(degraded.coverage() >= 0.80);
+  CHECK(degraded.near_segment_share() >= 0.90);
+  CHECK(degraded.coverage() >= 0.78);
   CHECK(degraded.free_known_share() >= 0.90);
   CHECK(degraded.free_overclaim_share() <= 0.17);
 }
