@@ -2,6 +2,7 @@
 #include <cstdio>
 #include <exception>
 
+#include "calibrate_command.hpp"
 #include "degrade_command.hpp"
 #include "echo_command.hpp"
 #include "evaluate_command.hpp"
@@ -23,6 +24,7 @@ int main(int argc, char **argv) {
   omnislam::app::add_map_command(app);
   omnislam::app::add_profile_command(app);
   omnislam::app::add_echo_command(app);
+  omnislam::app::add_calibrate_command(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError &error) {
