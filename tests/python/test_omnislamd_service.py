@@ -245,3 +245,35 @@ service: {{output_dir: {tmp_path / 'out'}}}
     errors = [((float(e[1]) - float(t[1])) ** 2 + (float(e[2]) - float(t[2])) ** 2) ** 0.5
               for e, t in zip(estimate, truth)]
     assert max(errors) < 0.25, errors
+
+
+@pytest.mark.parametrize("shift", [(0.0, 0.0), (1.2, -0.8)])
+def test_rig_check_at_start_warns_when_the_rim_is_off_centre(tmp_path, shift):
+    """The first live image's mirror rim against camera.center_px: within 0.5 px an info line,
+    beyond it a warning in the journal (and the status); the service runs on either way."""
+    import sys
+    sys.path.insert(0, str(REPO / "scripts"))
+    sys.path.insert(0, str(REPO / "tests" / "python"))
+    from omnislam_render.pngio import read_png, to_gray, write_png_gray
+    from test_calibrate_cli import shifted
+    images = tmp_path / "images"
+    images.mkdir()
+    for frame in range(1, 4):
+        image = to_gray(read_png(DATASET / "images" / f"{frame:06d}.png"))
+        write_png_gray(images / f"{frame:06d}.png", shifted(image, *shift))
+    config = tmp_path / "c.yaml"
+    config.write_text(f"""
+input: {{source: video, path: {images}/%06d.png, odometry: none, rate_hz: 0}}
+pipeline: {{mode: replay}}
+dds: {{enabled: false}}
+""")
+    service = start(config)
+    log, _ = service.communicate(timeout=120)
+    assert service.returncode == 0, log
+    assert "3 frames in, 3 out, 0 dropped, 0 skipped" in log
+    check = [line for line in log.splitlines() if "rig check:" in line]
+    assert len(check) == 1, log
+    off = (shift[0] ** 2 + shift[1] ** 2) ** 0.5
+    assert f"{off:.2f} px from the configured (511.50, 511.50)" in check[0]
+    assert ("[warning]" in check[0]) == (off > 0.5), check[0]
+    assert ("omnislam calibrate rim" in check[0]) == (off > 0.5)

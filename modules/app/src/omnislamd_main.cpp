@@ -13,12 +13,14 @@
 #include <limits>
 #include <memory>
 #include <optional>
+#include <utility>
 
 #include "frame_record.hpp"
 #include "omnislam/dds/odometry_reader.hpp"
 #include "omnislam/dds/publisher.hpp"
 #include "omnislam/io/config.hpp"
 #include "omnislam/pipeline/pipeline.hpp"
+#include "rig_check.hpp"
 #include "run_outputs.hpp"
 #include "service_input.hpp"
 #include "service_state.hpp"
@@ -65,6 +67,27 @@ pipeline::PipelineConfig pipeline_config(const io::Config &config, double rate_h
     }
   }
   return result;
+}
+
+// The first frame is taken here, before the pipeline starts, to check the rig on it; the
+// source returned hands it on first. A rig off its configured centre is logged and put in
+// the status (last_error) while the service runs: a knocked rig maps badly, it does not stop.
+pipeline::FrameSource checked_source(pipeline::FrameSource source, const mirror::MirrorConfig &camera,
+                                     dds::StatusMessage &status) {
+  auto first = std::make_shared<pipeline::FramePtr>(source());
+  if (*first && (*first)->error.empty() && !(*first)->image.empty()) {
+    const RigCheck check = check_rig((*first)->image, camera);
+    if (check.off) {
+      spdlog::warn("{}", check.message);
+      status.last_error = check.message;
+    } else {
+      spdlog::info("{}", check.message);
+    }
+  }
+  return [first, source = std::move(source)]() mutable -> pipeline::FramePtr {
+    if (*first) return std::exchange(*first, nullptr);
+    return source();
+  };
 }
 
 int run_service(const std::string &config_file) {
@@ -173,12 +196,14 @@ int run_service(const std::string &config_file) {
     pipeline.resume(resumed->points, resumed->map_integrations, resumed->T_map_base, resumed->covariance,
                     resumed->T_odom_base);
   }
-  pipeline.start(input.source);
+  pipeline.start(checked_source(input.source, config.scan.camera, status));
   status.state = dds::ServiceState::kRunning;
   status.stamp_s = system_time_s();
   if (publisher) publisher->status(status);
   const SystemdNotifier notifier;
-  notifier.ready("running: " + input.description);
+  // systemd's STATUS line carries the rig check's warning too (systemctl status shows it).
+  notifier.ready("running: " + input.description +
+                 (status.last_error.empty() ? "" : "; " + status.last_error));
 
   const bool signalled = supervise(pipeline, signals, notifier, service.stage_timeout_s, counts);
   notifier.stopping(signalled ? "stopping: draining the pipeline" : "stopping: the input ended");
