@@ -1,5 +1,6 @@
 #include "calibrate_command.hpp"
 
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -10,6 +11,7 @@
 #include <vector>
 
 #include "omnislam/calib/rim.hpp"
+#include "omnislam/calib/sensitivity.hpp"
 #include "omnislam/io/config.hpp"
 #include "omnislam/io/image_file.hpp"
 
@@ -88,6 +90,25 @@ void run_rim(const RimOptions &options) {
   std::printf("wrote %s\n", options.out.c_str());
 }
 
+void run_sensitivity(const std::string &config_file) {
+  const io::Config config = config_file.empty() ? io::Config{} : io::load_config(config_file);
+  std::printf(
+      "Range error of a wall's base on the floor per parameter error (camera %.2f m above the floor):\n\n",
+      config.scan.camera_height_m);
+  std::printf("| parameter | error | floor plane, 1 / 2 / 4 m | stereo, 1 / 2 / 4 m |\n|---|---|---|---|\n");
+  const auto millimetres = [](const std::array<double, 3> &errors) {
+    char text[64];
+    std::snprintf(text, sizeof text, "%.1f / %.1f / %.1f mm", errors[0] * 1000.0, errors[1] * 1000.0,
+                  errors[2] * 1000.0);
+    return std::string(text);
+  };
+  for (const calib::RangeSensitivity &row :
+       calib::range_sensitivity(config.scan.camera, config.scan.camera_height_m)) {
+    std::printf("| %s | %s | %s | %s |\n", row.parameter.c_str(), row.step.c_str(),
+                millimetres(row.floor_plane_m).c_str(), millimetres(row.stereo_m).c_str());
+  }
+}
+
 }  // namespace
 
 void add_calibrate_command(CLI::App &app) {
@@ -100,6 +121,11 @@ void add_calibrate_command(CLI::App &app) {
   rim->add_option("--config", options->config, "YAML configuration (camera: where the search starts)");
   rim->add_option("--out", options->out, "YAML file to write (camera: {center_px: [u, v]})")->required();
   rim->callback([options] { run_rim(*options); });
+  auto *sensitivity = calibrate->add_subcommand(
+      "sensitivity", "range error at 1, 2 and 4 m per unit error of each rig parameter (Markdown table)");
+  auto config_file = std::make_shared<std::string>();
+  sensitivity->add_option("--config", *config_file, "YAML configuration (camera, camera_height_m)");
+  sensitivity->callback([config_file] { run_sensitivity(*config_file); });
 }
 
 }  // namespace omnislam::app

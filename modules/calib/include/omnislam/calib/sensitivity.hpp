@@ -1,0 +1,31 @@
+#pragma once
+
+#include <array>
+#include <string>
+#include <vector>
+
+#include "omnislam/mirror/mirror_config.hpp"
+
+/// @file
+/// What an error in a rig parameter costs in range: a wall's base on the floor at 1, 2 and
+/// 4 m is imaged by the rig as it is (the parameter off by one step) and read back with the
+/// parameters as configured, by the floor plane (the default front-end's range) and by
+/// stereo triangulation of the two lobes.
+
+namespace omnislam::calib {
+
+inline constexpr std::array<double, 3> kSensitivityRangesM{1.0, 2.0, 4.0};
+
+struct RangeSensitivity {
+  std::string parameter;                  ///< "centre", "focal length", ...
+  std::string step;                       ///< the error the row is for, e.g. "1 px", "0.1%"
+  std::array<double, 3> floor_plane_m{};  ///< |range error| at kSensitivityRangesM, floor plane
+  std::array<double, 3> stereo_m{};       ///< the same, triangulated (NaN where unseen)
+};
+
+/// One row per parameter the mirror model represents (the centre, worst azimuth; the focal
+/// length), for a camera `camera_height_m` above the floor.
+[[nodiscard]] std::vector<RangeSensitivity> range_sensitivity(const mirror::MirrorConfig &camera,
+                                                              double camera_height_m);
+
+}  // namespace omnislam::calib
