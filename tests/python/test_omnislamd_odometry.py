@@ -47,11 +47,13 @@ class OdometryPublisher:
     """50 Hz, stamped with the system clock (as frames are); silent during [gap_from, gap_to)
     seconds after start()."""
 
-    def __init__(self, domain: int, gap_from: float, gap_to: float):
+    def __init__(self, domain: int, gap_from: float, gap_to: float, reliable: bool = True):
         self.participant = DomainParticipant(domain)
         topic = Topic(self.participant, "rt/odom", Odometry_)
-        self.writer = DataWriter(self.participant, topic, qos=Qos(Policy.Reliability.Reliable(duration(seconds=1)),
-                                                                   Policy.History.KeepLast(50)))
+        # A base driver's sensor-data QoS is best effort; nav2 examples and ours are reliable.
+        reliability = (Policy.Reliability.Reliable(duration(seconds=1)) if reliable
+                       else Policy.Reliability.BestEffort)
+        self.writer = DataWriter(self.participant, topic, qos=Qos(reliability, Policy.History.KeepLast(50)))
         self.gap = (gap_from, gap_to)
         self.running = True
         self.published = 0
@@ -111,3 +113,36 @@ service: {{output_dir: {tmp_path / 'out'}}}
              if not line.startswith("#")]
     assert len(poses) == 40
     assert max(abs(float(p[1])) + abs(float(p[2])) for p in poses) < 0.02
+
+
+def test_a_best_effort_odometry_writer_is_matched(tmp_path):
+    """The sensor-data QoS of ROS 2 base drivers (best effort) feeds omnislamd as well."""
+    images = tmp_path / "images"
+    images.mkdir()
+    first = REPO / "datasets" / "sim-room-37" / "images" / "000001.png"
+    for i in range(20):
+        shutil.copy(first, images / f"{i:06d}.png")
+    domain = 100 + (os.getpid() * 2 + 9) % 100
+    config = tmp_path / "omnislamd.yaml"
+    config.write_text(f"""
+input: {{source: directory, path: {images}, rate_hz: 10, odometry: dds}}
+pipeline: {{mode: replay}}
+dds: {{domain_id: {domain}}}
+service: {{output_dir: {tmp_path / 'out'}}}
+""")
+    publisher = OdometryPublisher(domain, gap_from=1e9, gap_to=1e9, reliable=False)
+    publisher.start()
+    time.sleep(1.0)  # discovery
+    try:
+        service = subprocess.run([os.environ["OMNISLAMD_BIN"], "--config", str(config)], capture_output=True,
+                                 text=True, timeout=120)
+    finally:
+        publisher.stop()
+    log = service.stdout + service.stderr
+    assert service.returncode == 0, log
+    stopped = next(line for line in log.splitlines() if "stopped:" in line)
+    assert "20 frames in, 20 out, 0 dropped, 0 skipped" in stopped, log
+    # Matched, so odometry flows (an unmatched reader would leave all 20 frames without);
+    # the first frame or two may come before the service's reader has discovered the writer.
+    without = int(stopped.split(" skipped, ")[1].split()[0])
+    assert without <= 2, log
