@@ -82,7 +82,6 @@ std::vector<std::size_t> NearestNeighbors::within(const Point2 &query, double ra
 }
 
 const Point2 &NearestNeighbors::normal(std::size_t index) const {
-  constexpr double kNormalRadiusM = 0.15;
   if (normal_known_.empty()) {
     normals_.assign(points_.size(), Point2::Zero());
     normal_known_.assign(points_.size(), false);

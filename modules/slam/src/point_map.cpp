@@ -1,22 +1,61 @@
 #include "omnislam/slam/point_map.hpp"
 
 #include <algorithm>
+#include <limits>
 #include <utility>
 
 namespace omnislam::slam {
+namespace {
+
+constexpr double kInfinity = std::numeric_limits<double>::infinity();
+
+}  // namespace
+
+void PointMap::Box::add(const Point2 &p) {
+  min = min.cwiseMin(p);
+  max = max.cwiseMax(p);
+}
+
+PointMap::Box PointMap::Box::grown(double margin_m) const {
+  return {min.array() - margin_m, max.array() + margin_m};
+}
+
+bool PointMap::Box::contains(const Point2 &p) const {
+  return (p.array() >= min.array()).all() && (p.array() <= max.array()).all();
+}
+
+bool PointMap::Box::contains(const Box &other) const {
+  return (other.min.array() >= min.array()).all() && (other.max.array() <= max.array()).all();
+}
+
+PointMap::Box PointMap::Box::everything() {
+  return {Point2::Constant(-kInfinity), Point2::Constant(kInfinity)};
+}
+
+PointMap::Box PointMap::Box::nothing() { return {Point2::Constant(kInfinity), Point2::Constant(-kInfinity)}; }
 
 PointMap::PointMap(PointMapConfig config, std::vector<MapPoint> points, int integrations)
     : config_(config), points_(std::move(points)), integrations_(integrations), check_all_(true) {
-  rebuild_index();
+  index_points_in(Box::everything());
 }
 
 void PointMap::integrate(const Points2 &points_map) {
   ++integrations_;
+  // Everything this integration changes or checks lies near the scan or near the points
+  // removed last time; the index covers that region only, so its cost follows the scan,
+  // not the map (a restored map is checked whole once).
+  Box touched = Box::nothing();
+  for (const Point2 &p : points_map) touched.add(p);
+  for (const Point2 &p : removed_since_filter_) touched.add(p);
+  const double reach = config_.fusion_radius_m + 2.0 * config_.noise_radius_m;
+  const Box region = check_all_ ? Box::everything() : touched.grown(std::max(reach, config_.local_margin_m));
+  if (!indexed_.contains(touched.grown(config_.fusion_radius_m))) index_points_in(region);
+
   // Fusion (thesis sec. 5.3): a point near an existing one becomes their hit-weighted mean.
   std::vector<MapPoint> added;
   for (const Point2 &p : points_map) {
     if (const auto hit = index_.nearest(p, config_.fusion_radius_m)) {
-      MapPoint &target = points_[hit->index];
+      MapPoint &target = points_[indexed_points_[hit->index]];
       target.position_m = (target.position_m * target.hits + p) / (target.hits + 1);
       ++target.hits;
     } else {
@@ -24,17 +63,17 @@ void PointMap::integrate(const Points2 &points_map) {
     }
   }
   points_.insert(points_.end(), added.begin(), added.end());
-  rebuild_index();
+  index_points_in(region);
 
   // Noise filter: a point needs noise_min_neighbors others within noise_radius_m. Only the
   // points near the scan or near a removed point can fail where they passed before.
   std::vector<char> check(points_.size(), check_all_ ? 1 : 0);
   if (!check_all_) {
-    const double reach = config_.noise_radius_m + config_.fusion_radius_m;
+    const double near_scan = config_.noise_radius_m + config_.fusion_radius_m;
     for (const Point2 &p : points_map)
-      for (const std::size_t i : index_.within(p, reach)) check[i] = 1;
+      for (const std::size_t i : index_.within(p, near_scan)) check[indexed_points_[i]] = 1;
     for (const Point2 &p : removed_since_filter_)
-      for (const std::size_t i : index_.within(p, config_.noise_radius_m)) check[i] = 1;
+      for (const std::size_t i : index_.within(p, config_.noise_radius_m)) check[indexed_points_[i]] = 1;
   }
   check_all_ = false;
   removed_since_filter_.clear();
@@ -59,15 +98,29 @@ void PointMap::integrate(const Points2 &points_map) {
   }
   if (kept.size() != points_.size()) {
     points_ = std::move(kept);
-    rebuild_index();
+    index_points_in(region);
   }
 }
 
-void PointMap::rebuild_index() {
+const NearestNeighbors &PointMap::index_near(const Points2 &points_map, double reach_m) {
+  if (check_all_) return index_;  // a restored map: the whole map is indexed until it changes
+  Box needed = Box::nothing();
+  for (const Point2 &p : points_map) needed.add(p);
+  if (!indexed_.contains(needed.grown(reach_m)))
+    index_points_in(needed.grown(std::max(reach_m, config_.local_margin_m)));
+  return index_;
+}
+
+void PointMap::index_points_in(const Box &region) {
   Points2 positions;
-  positions.reserve(points_.size());
-  for (const MapPoint &point : points_) positions.push_back(point.position_m);
+  indexed_points_.clear();
+  for (std::size_t i = 0; i < points_.size(); ++i) {
+    if (!region.contains(points_[i].position_m)) continue;
+    positions.push_back(points_[i].position_m);
+    indexed_points_.push_back(i);
+  }
   index_ = NearestNeighbors(std::move(positions));
+  indexed_ = region;
 }
 
 }  // namespace omnislam::slam

@@ -48,6 +48,17 @@ bool Slam::accept_without_odometry(const TrimmedIcpResult &registration, const E
          std::abs(yaw_rad_of(correction)) <= config_.no_odometry_max_rotation_rad;
 }
 
+double Slam::registration_reach_m(const Points2 &scan_base) const {
+  double farthest_m = 0.0;
+  for (const Point2 &p : scan_base) farthest_m = std::max(farthest_m, p.norm());
+  const double translation_m =
+      config_.use_odometry ? config_.max_correction_m : config_.icp.initial_search_radius_m;
+  const double rotation_rad =
+      config_.use_odometry ? config_.max_correction_rad : config_.no_odometry_max_rotation_rad;
+  return config_.icp.initial_search_radius_m + translation_m + farthest_m * std::abs(rotation_rad) +
+         kNormalRadiusM;
+}
+
 FrameEstimate Slam::register_scan(const Points2 &scan_base, const Eigen::Isometry2d &predicted) {
   const double srel_limit = config_.srel_limit_percent + relaxation_percent_;
   auto accepted = [&](const TrimmedIcpResult &r, const Eigen::Isometry2d &pose) {
@@ -75,7 +86,10 @@ FrameEstimate Slam::register_scan(const Points2 &scan_base, const Eigen::Isometr
     return true;
   };
 
-  if (config_.target == RegistrationTarget::kMap && try_forward(map_.index(), Attempt::kMap)) return estimate;
+  if (config_.target == RegistrationTarget::kMap &&
+      try_forward(map_.index_near(transformed(scan_base, predicted), registration_reach_m(scan_base)),
+                  Attempt::kMap))
+    return estimate;
   // The thesis registers against the previous scan (with odometry), or against each of
   // the last three (without), forward then reverse.
   const std::size_t scans = config_.use_odometry ? 1 : recent_scans_map_.size();
@@ -145,8 +159,9 @@ FrameEstimate Slam::process(const Points2 &scan_base, const std::optional<Eigen:
 
   if (estimate.integrated && previous_failed_ && config_.optional_map_correction &&
       config_.target == RegistrationTarget::kPreviousScan) {
-    const TrimmedIcpResult refined =
-        register_trimmed_icp(map_.index(), scan_base, estimate.T_map_base, config_.icp);
+    const TrimmedIcpResult refined = register_trimmed_icp(
+        map_.index_near(transformed(scan_base, estimate.T_map_base), registration_reach_m(scan_base)),
+        scan_base, estimate.T_map_base, config_.icp);
     if (accept(refined, predicted, refined.T_model_sample, 50.0))
       estimate.T_map_base = refined.T_model_sample;
   }

@@ -19,6 +19,9 @@ struct Neighbor {
   double distance_sq_m2 = 0.0;
 };
 
+/// Radius of the neighbourhood a point's normal is fitted to.
+inline constexpr double kNormalRadiusM = 0.15;
+
 /// Owns its points and an index built once in the constructor. Move-only; not thread-safe
 /// (normals are computed lazily).
 class NearestNeighbors {
@@ -33,7 +36,7 @@ class NearestNeighbors {
   [[nodiscard]] const Points2 &points() const { return points_; }
 
   /// Unit normal of the local line through point `index` (PCA of its neighbours within
-  /// 0.15 m), or zero where fewer than 3 points lie there. Computed on first use and cached,
+  /// kNormalRadiusM), or zero where fewer than 3 points lie there. Computed on first use and cached,
   /// so a registration pays only for the points it pairs with.
   [[nodiscard]] const Point2 &normal(std::size_t index) const;
   [[nodiscard]] bool empty() const { return points_.empty(); }

@@ -102,6 +102,11 @@ class Slam {
   [[nodiscard]] bool accept(const TrimmedIcpResult &registration, const Eigen::Isometry2d &predicted,
                             const Eigen::Isometry2d &estimate, double srel_limit_percent) const;
   [[nodiscard]] FrameEstimate register_scan(const Points2 &scan_base, const Eigen::Isometry2d &predicted);
+  /// How far beyond a scan at its predicted pose the map must be indexed for a registration
+  /// to see all it would see in the whole map: the first search radius, the largest
+  /// correction accepted (its translation, and its rotation swinging the scan's farthest
+  /// point), and the neighbourhood of a paired point's normal.
+  [[nodiscard]] double registration_reach_m(const Points2 &scan_base) const;
   void set_anchor(const Eigen::Isometry2d &T_odom_base, const Eigen::Isometry2d &T_map_base);
   [[nodiscard]] FrameEstimate seed_map(const Points2 &scan_base);
   [[nodiscard]] bool accept_without_odometry(const TrimmedIcpResult &registration,
