@@ -4,6 +4,7 @@ Asserts the accuracy the project claims in the README against the thesis's C++ r
 (83 mm worst-case position error on its simulated room, 1 of 37 images not integrated).
 """
 import json
+import math
 import os
 import pathlib
 import subprocess
@@ -135,3 +136,60 @@ def test_replay_realistic_degraded(tmp_path, name):
         assert evaluation["ate"]["final_m"] <= want["final_m"]
     assert evaluation["map"]["median_distance_m"] <= want["median_m"]
     assert evaluation["map"]["completeness"] >= want["completeness"]
+
+
+def read_nav2_map(yaml_file):
+    """The grid as nav2_map_server's trinary mode reads it: occupied where 1 - shade exceeds
+    occupied_thresh, free below free_thresh, unknown between; row 0 at the origin."""
+    import numpy as np
+    fields = dict(line.split(": ", 1) for line in yaml_file.read_text().splitlines())
+    assert fields["mode"] == "trinary" and fields["negate"] == "0"
+    data = (yaml_file.parent / fields["image"]).read_bytes()
+    magic, size, depth, pixels = data.split(b"\n", 3)
+    assert magic == b"P5" and depth == b"255"
+    width, height = map(int, size.split())
+    shade = np.frombuffer(pixels, np.uint8).reshape(height, width) / 255.0
+    occupied = 1.0 - shade
+    cells = np.where(occupied > float(fields["occupied_thresh"]), 100,
+                     np.where(occupied < float(fields["free_thresh"]), 0, -1))[::-1]
+    origin = [float(v) for v in fields["origin"].strip("[]").split(",")[:2]]
+    return cells, float(fields["resolution"]), origin
+
+
+def test_replay_writes_a_nav2_occupancy_grid_of_the_room(tmp_path):
+    """map.yaml + map.pgm (nav2_map_server's format): walls where the floor plan has them,
+    free floor where the robot saw it, no free cell on a wall."""
+    import numpy as np
+    out = tmp_path / "run"
+    run("replay", DATASET, "--out", out)
+    cells, resolution, origin = read_nav2_map(out / "map.yaml")
+    segments = [tuple(map(float, line.split(","))) for line in
+                (DATASET / "floorplan.csv").read_text().splitlines()[1:]]
+
+    def distance_to_plan(x, y):
+        best = math.inf
+        for x1, y1, x2, y2 in segments:
+            ex, ey = x2 - x1, y2 - y1
+            length = ex * ex + ey * ey
+            t = max(0.0, min(1.0, ((x - x1) * ex + (y - y1) * ey) / length)) if length > 0 else 0.0
+            best = min(best, math.hypot(x - x1 - t * ex, y - y1 - t * ey))
+        return best
+
+    def distances(value):  # of the cells holding `value`, to the plan
+        rows, cols = np.nonzero(cells == value)
+        return np.array([distance_to_plan(origin[0] + (c + 0.5) * resolution, origin[1] + (r + 0.5) * resolution)
+                         for r, c in zip(rows, cols)])
+
+    occupied = distances(100)
+    rows, cols = np.nonzero(cells == 0)
+    free_x, free_y = origin[0] + (cols + 0.5) * resolution, origin[1] + (rows + 0.5) * resolution
+    xs = [v for s in segments for v in (s[0], s[2])]
+    ys = [v for s in segments for v in (s[1], s[3])]
+    outside = (free_x < min(xs)) | (free_x > max(xs)) | (free_y < min(ys)) | (free_y > max(ys))
+    print(f"occupied {len(occupied)} cells, {np.mean(occupied <= 0.1) * 100:.1f}% within 0.1 m of the plan; "
+          f"free {len(rows)} cells ({len(rows) * resolution ** 2:.1f} m2), {np.sum(outside)} outside the walls")
+    assert len(occupied) > 400
+    assert np.mean(occupied <= 0.1) >= 0.90
+    # The room is 8 x 4 m with furniture: most of its floor was seen free, nothing beyond its walls.
+    assert len(rows) * resolution ** 2 >= 18.0
+    assert np.sum(outside) <= 0.001 * len(rows)

@@ -10,12 +10,15 @@
 #include "dataset_source.hpp"
 #include "degradation_options.hpp"
 #include "frame_record.hpp"
+#include "omnislam/grid/occupancy_grid.hpp"
 #include "omnislam/io/config.hpp"
 #include "omnislam/io/dataset.hpp"
+#include "omnislam/io/grid_files.hpp"
 #include "omnislam/io/poses.hpp"
 #include "omnislam/pipeline/pipeline.hpp"
 #include "omnislam/slam/odometry_noise.hpp"
 #include "run_outputs.hpp"
+#include "scan_rays.hpp"
 
 namespace omnislam::app {
 namespace {
@@ -70,8 +73,13 @@ void run_replay(const ReplayOptions &options, std::optional<std::uint64_t> degra
   pipeline_config.mode = pipeline::Mode::kReplay;
   pipeline_config.map_every_integration = true;  // the thesis's mapaN.txt after every image
   pipeline::Sinks sinks;
+  // The occupancy grid of the run (map.yaml + map.pgm): every frame's boundary points and
+  // free floor at the pose it was given.
+  grid::OccupancyGrid occupancy;
   sinks.frame = [&](const pipeline::Frame &frame) {
     run.frames.push_back(frame_record(frame));
+    if (!frame.skipped())
+      occupancy.add_scan(frame.estimate.T_map_base, scan_rays(frame.scan, config.scan.camera));
     if (frame.estimate.integrated && frame.map)
       writer.write_thesis_map(static_cast<int>(frame.sequence), *frame.map);
   };
@@ -91,6 +99,9 @@ void run_replay(const ReplayOptions &options, std::optional<std::uint64_t> degra
   pipeline.run(dataset_source(info, odometry, config.scan.camera, std::move(source_options)));
   if (!pipeline.error().empty()) throw std::runtime_error(pipeline.error());
   writer.write_all(run, pipeline.slam().map(), info);
+  const grid::GridImage grid_image = occupancy.image();
+  if (grid_image.width > 0)
+    io::write_nav2_map(std::filesystem::path(options.out_dir) / "map.yaml", grid_image);
 }
 
 }  // namespace

@@ -1,0 +1,40 @@
+#pragma once
+
+#include <cmath>
+#include <limits>
+#include <numbers>
+#include <vector>
+
+#include "omnislam/grid/occupancy_grid.hpp"
+#include "omnislam/mirror/panorama_maps.hpp"
+#include "omnislam/stereo/local_scan.hpp"
+
+namespace omnislam::app {
+
+/// A local scan as occupancy-grid rays, one per panorama column: the boundary point of the
+/// column (if any) and how far the floor was seen to be free there (floor-boundary scans).
+[[nodiscard]] inline std::vector<grid::Ray> scan_rays(const stereo::LocalScan &scan,
+                                                      const mirror::MirrorConfig &camera) {
+  constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+  const int columns = camera.columns;
+  std::vector<grid::Ray> rays(static_cast<std::size_t>(columns));
+  for (int column = 0; column < columns; ++column) {
+    const double free_m = static_cast<std::size_t>(column) < scan.free_range_m.size()
+                              ? static_cast<double>(scan.free_range_m[static_cast<std::size_t>(column)])
+                              : kNaN;
+    rays[static_cast<std::size_t>(column)] = {mirror::column_azimuth_rad(camera, column), kNaN, free_m};
+  }
+  // One boundary per column (nearest first): the point's azimuth names its column.
+  const double column_rad = 2.0 * std::numbers::pi / columns;
+  const double offset_rad = camera.azimuth_offset_deg * std::numbers::pi / 180.0;
+  for (const stereo::ScanPoint &point : scan.points) {
+    const double turns =
+        std::remainder(point.azimuth_rad - offset_rad - 0.5 * column_rad, 2.0 * std::numbers::pi);
+    const int column = ((static_cast<int>(std::lround(turns / column_rad)) % columns) + columns) % columns;
+    grid::Ray &ray = rays[static_cast<std::size_t>(column)];
+    if (!std::isfinite(ray.hit_m) || point.range_m < ray.hit_m) ray.hit_m = point.range_m;
+  }
+  return rays;
+}
+
+}  // namespace omnislam::app

@@ -1,0 +1,73 @@
+#pragma once
+
+#include <Eigen/Geometry>
+#include <cstdint>
+#include <span>
+#include <unordered_map>
+#include <vector>
+
+/// @file
+/// An occupancy grid from local scans (issue 14): each ray marks the cells it crosses as
+/// free up to how far the floor was seen to be free, and the cell of its boundary point as
+/// occupied, in log-odds (the usual inverse sensor model). The grid grows with what is seen.
+
+namespace omnislam::grid {
+
+struct GridConfig {
+  double resolution_m = 0.05;
+  /// Inverse sensor model: P(occupied) of a cell holding a boundary point, of a cell a ray
+  /// crossed as free floor; each observation adds its log-odds, clamped to the bounds.
+  double hit_probability = 0.7;
+  double miss_probability = 0.4;
+  double min_probability = 0.12;
+  double max_probability = 0.97;
+  /// Trinary cells (nav2 map_server's defaults): occupied at or above, free at or below.
+  double occupied_threshold = 0.65;
+  double free_threshold = 0.25;
+};
+
+/// One ray of a scan in the robot frame: a boundary at hit_m (NaN: none found) and free floor
+/// up to free_m (NaN: unknown).
+struct Ray {
+  double azimuth_rad = 0.0;
+  double hit_m = 0.0;
+  double free_m = 0.0;
+};
+
+/// The grid as nav_msgs/OccupancyGrid lays it out: row-major from the cell at `origin_m`
+/// (its lower-left corner), x along a row, rows towards +y; -1 unknown, 0 free, 100 occupied.
+struct GridImage {
+  int width = 0;
+  int height = 0;
+  double resolution_m = 0.05;
+  Eigen::Vector2d origin_m = Eigen::Vector2d::Zero();
+  std::vector<std::int8_t> cells;
+};
+
+class OccupancyGrid {
+ public:
+  explicit OccupancyGrid(const GridConfig &config = {});
+
+  /// Adds one scan taken at `T_map_base`.
+  void add_scan(const Eigen::Isometry2d &T_map_base, std::span<const Ray> rays);
+
+  /// The trinary grid over every cell observed so far (empty when none is).
+  [[nodiscard]] GridImage image() const;
+
+  [[nodiscard]] const GridConfig &config() const { return config_; }
+
+ private:
+  using Cell = Eigen::Vector2i;
+  [[nodiscard]] Cell cell_of(const Eigen::Vector2d &point_m) const;
+  void update(const Cell &cell, float log_odds);
+  /// Cells from `from_m` towards `to_m`, each once, excluding the cell of `to_m`.
+  void mark_free(const Eigen::Vector2d &from_m, const Eigen::Vector2d &to_m);
+
+  [[nodiscard]] static std::uint64_t key(const Cell &cell);
+
+  GridConfig config_;
+  float hit_ = 0.0f, miss_ = 0.0f, min_ = 0.0f, max_ = 0.0f;
+  std::unordered_map<std::uint64_t, float> log_odds_;
+};
+
+}  // namespace omnislam::grid

@@ -1,0 +1,103 @@
+#include "omnislam/grid/occupancy_grid.hpp"
+
+#include <algorithm>
+#include <climits>
+#include <cmath>
+#include <limits>
+
+namespace omnislam::grid {
+namespace {
+
+float log_odds_of(double probability) {
+  return static_cast<float>(std::log(probability / (1.0 - probability)));
+}
+
+}  // namespace
+
+OccupancyGrid::OccupancyGrid(const GridConfig &config)
+    : config_(config),
+      hit_(log_odds_of(config.hit_probability)),
+      miss_(log_odds_of(config.miss_probability)),
+      min_(log_odds_of(config.min_probability)),
+      max_(log_odds_of(config.max_probability)) {}
+
+std::uint64_t OccupancyGrid::key(const Cell &cell) {
+  return (static_cast<std::uint64_t>(static_cast<std::uint32_t>(cell.x())) << 32) |
+         static_cast<std::uint32_t>(cell.y());
+}
+
+OccupancyGrid::Cell OccupancyGrid::cell_of(const Eigen::Vector2d &point_m) const {
+  return {static_cast<int>(std::floor(point_m.x() / config_.resolution_m)),
+          static_cast<int>(std::floor(point_m.y() / config_.resolution_m))};
+}
+
+void OccupancyGrid::update(const Cell &cell, float log_odds) {
+  float &value = log_odds_[key(cell)];
+  value = std::clamp(value + log_odds, min_, max_);
+}
+
+void OccupancyGrid::mark_free(const Eigen::Vector2d &from_m, const Eigen::Vector2d &to_m) {
+  // Amanatides-Woo traversal: every cell the segment crosses, in order.
+  const Eigen::Vector2d start = from_m / config_.resolution_m, end = to_m / config_.resolution_m;
+  Cell cell = cell_of(from_m);
+  const Cell last = cell_of(to_m);
+  const Eigen::Vector2d direction = end - start;
+  Eigen::Vector2i step;
+  Eigen::Vector2d next, delta;
+  for (int axis = 0; axis < 2; ++axis) {
+    step[axis] = direction[axis] > 0.0 ? 1 : (direction[axis] < 0.0 ? -1 : 0);
+    const double boundary = step[axis] > 0 ? std::floor(start[axis]) + 1.0 : std::floor(start[axis]);
+    next[axis] = step[axis] != 0 ? (boundary - start[axis]) / direction[axis]
+                                 : std::numeric_limits<double>::infinity();
+    delta[axis] = step[axis] != 0 ? std::abs(1.0 / direction[axis]) : std::numeric_limits<double>::infinity();
+  }
+  while (cell != last) {
+    update(cell, miss_);
+    const int axis = next.x() < next.y() ? 0 : 1;
+    if (next[axis] > 1.0) break;  // the end lies in this cell after all (rounding)
+    cell[axis] += step[axis];
+    next[axis] += delta[axis];
+  }
+}
+
+void OccupancyGrid::add_scan(const Eigen::Isometry2d &T_map_base, std::span<const Ray> rays) {
+  const Eigen::Vector2d origin = T_map_base.translation();
+  for (const Ray &ray : rays) {
+    const Eigen::Vector2d direction =
+        T_map_base.linear() * Eigen::Vector2d(std::cos(ray.azimuth_rad), std::sin(ray.azimuth_rad));
+    const bool hit = std::isfinite(ray.hit_m) && ray.hit_m > 0.0;
+    // Free floor up to the boundary (never past it) or, with none, as far as it was seen.
+    double free_m = std::isfinite(ray.free_m) ? ray.free_m : 0.0;
+    if (hit) free_m = std::min(free_m, ray.hit_m);
+    if (free_m > 0.0) mark_free(origin, origin + free_m * direction);
+    if (hit) update(cell_of(origin + ray.hit_m * direction), hit_);
+  }
+}
+
+GridImage OccupancyGrid::image() const {
+  GridImage image;
+  image.resolution_m = config_.resolution_m;
+  if (log_odds_.empty()) return image;
+  Cell low(INT_MAX, INT_MAX), high(INT_MIN, INT_MIN);
+  for (const auto &[cell_key, value] : log_odds_) {
+    const Cell cell(static_cast<int>(static_cast<std::int32_t>(cell_key >> 32)),
+                    static_cast<int>(static_cast<std::int32_t>(cell_key & 0xffffffffu)));
+    low = low.cwiseMin(cell);
+    high = high.cwiseMax(cell);
+  }
+  image.width = high.x() - low.x() + 1;
+  image.height = high.y() - low.y() + 1;
+  image.origin_m = low.cast<double>() * config_.resolution_m;
+  image.cells.assign(static_cast<std::size_t>(image.width) * static_cast<std::size_t>(image.height), -1);
+  const float occupied = log_odds_of(config_.occupied_threshold), free = log_odds_of(config_.free_threshold);
+  for (const auto &[cell_key, value] : log_odds_) {
+    const int x = static_cast<int>(static_cast<std::int32_t>(cell_key >> 32)) - low.x();
+    const int y = static_cast<int>(static_cast<std::int32_t>(cell_key & 0xffffffffu)) - low.y();
+    std::int8_t &cell = image.cells[static_cast<std::size_t>(y) * static_cast<std::size_t>(image.width) +
+                                    static_cast<std::size_t>(x)];
+    cell = value >= occupied ? 100 : (value <= free ? 0 : -1);
+  }
+  return image;
+}
+
+}  // namespace omnislam::grid

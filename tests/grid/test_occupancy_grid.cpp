@@ -1,0 +1,61 @@
+#include <catch2/catch.hpp>
+#include <cmath>
+#include <limits>
+#include <vector>
+
+#include "omnislam/grid/occupancy_grid.hpp"
+
+using omnislam::grid::GridImage;
+using omnislam::grid::OccupancyGrid;
+using omnislam::grid::Ray;
+
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+int at(const GridImage &image, double x_m, double y_m) {
+  const int x = static_cast<int>(std::floor((x_m - image.origin_m.x()) / image.resolution_m));
+  const int y = static_cast<int>(std::floor((y_m - image.origin_m.y()) / image.resolution_m));
+  REQUIRE(x >= 0);
+  REQUIRE(y >= 0);
+  REQUIRE(x < image.width);
+  REQUIRE(y < image.height);
+  return image.cells[static_cast<std::size_t>(y) * static_cast<std::size_t>(image.width) +
+                     static_cast<std::size_t>(x)];
+}
+
+}  // namespace
+
+TEST_CASE("occupancy grid: free floor up to the boundary, the boundary occupied, the rest unknown",
+          "[grid]") {
+  OccupancyGrid grid({.resolution_m = 0.1});
+  const Eigen::Isometry2d pose = Eigen::Translation2d(0.05, 0.05) * Eigen::Rotation2Dd(0.0);
+  // Along +x a wall at 1 m; along +y free floor seen to 0.5 m, no boundary; along -x nothing.
+  const std::vector<Ray> rays = {{0.0, 1.0, 1.0}, {M_PI / 2, kNaN, 0.5}, {M_PI, kNaN, kNaN}};
+  for (int i = 0; i < 3; ++i) grid.add_scan(pose, rays);
+  const GridImage image = grid.image();
+  CHECK(image.resolution_m == 0.1);
+  CHECK(image.origin_m.x() == Approx(0.0));
+  CHECK(image.origin_m.y() == Approx(0.0));
+  CHECK(image.width == 11);  // cells 0..10 along x: 0..9 free, 10 the wall
+  CHECK(image.height == 5);  // cells 0..4 along y, free to 0.5 m (the cell of 0.55 m not reached)
+  for (double x = 0.05; x < 1.0; x += 0.1) CHECK(at(image, x, 0.05) == 0);
+  CHECK(at(image, 1.05, 0.05) == 100);
+  for (double y = 0.05; y < 0.5; y += 0.1) CHECK(at(image, 0.05, y) == 0);
+  CHECK(at(image, 0.55, 0.35) == -1);  // never observed
+}
+
+TEST_CASE("occupancy grid: one free pass over a boundary cell does not clear it; the pose rotates the rays",
+          "[grid]") {
+  OccupancyGrid grid({.resolution_m = 0.1});
+  const Eigen::Isometry2d facing_y = Eigen::Translation2d(0.05, 0.05) * Eigen::Rotation2Dd(M_PI / 2);
+  const std::vector<Ray> wall = {{0.0, 0.6, 0.6}};  // ahead, i.e. along +y in the map
+  grid.add_scan(facing_y, wall);
+  grid.add_scan(facing_y, wall);
+  grid.add_scan(facing_y, std::vector<Ray>{{0.0, kNaN, 1.0}});  // one look past it
+  const GridImage image = grid.image();
+  CHECK(at(image, 0.05, 0.65) == 100);  // hit twice (+0.85 each), missed once (-0.41): still occupied
+  CHECK(at(image, 0.05, 0.35) == 0);    // missed three times: P 0.23, free
+  CHECK(at(image, 0.05, 0.85) == -1);   // missed once: P 0.40, not yet free
+  CHECK(grid.image().width == 1);
+}
