@@ -1,4 +1,6 @@
+#include <Eigen/Cholesky>
 #include <catch2/catch.hpp>
+#include <random>
 
 #include "omnislam/slam/evaluation.hpp"
 #include "omnislam/slam/odometry_noise.hpp"
@@ -53,4 +55,33 @@ TEST_CASE("thesis odometry noise: seeded, bounded per step, composed", "[slam][o
     CHECK(std::abs(yaw_noisy - yaw_true) <=
           std::max(0.1 * std::abs(yaw_true), 1.5 * std::numbers::pi / 180.0) + 1e-12);
   }
+}
+
+TEST_CASE("covariance consistency: errors drawn from the covariance give NEES ~3 and 95% inside",
+          "[slam][eval]") {
+  std::mt19937_64 rng(5);
+  std::normal_distribution<double> unit(0.0, 1.0);
+  Eigen::Matrix3d P;
+  P << 4e-4, 1e-4, 0.0, 1e-4, 2e-4, 1e-5, 0.0, 1e-5, 1e-4;
+  const Eigen::Matrix3d L = P.llt().matrixL();
+  std::vector<Eigen::Isometry2d> estimate, truth;
+  std::vector<Eigen::Matrix3d> covariances;
+  for (int i = 0; i < 4000; ++i) {
+    const Eigen::Vector3d e = L * Eigen::Vector3d(unit(rng), unit(rng), unit(rng));
+    const Eigen::Isometry2d t = omnislam::slam::planar_pose(0.01 * i, -0.02 * i, 0.001 * i);
+    truth.push_back(t);
+    estimate.push_back(omnislam::slam::planar_pose(t.translation().x() + e.x(), t.translation().y() + e.y(),
+                                                   omnislam::slam::yaw_rad_of(t) + e.z()));
+    covariances.push_back(P);
+  }
+  covariances.front().setZero();  // the first frame's: not invertible, left out
+  auto consistency = omnislam::slam::covariance_consistency(estimate, truth, covariances);
+  CHECK(consistency.frames == 3999);
+  CHECK(consistency.mean_nees == Approx(3.0).margin(0.15));
+  CHECK(consistency.inside_95_share == Approx(0.95).margin(0.015));
+  // A covariance 100 times too small: NEES 100 times larger, few positions inside.
+  for (Eigen::Matrix3d &c : covariances) c /= 100.0;
+  consistency = omnislam::slam::covariance_consistency(estimate, truth, covariances);
+  CHECK(consistency.mean_nees == Approx(300.0).epsilon(0.06));
+  CHECK(consistency.inside_95_share < 0.1);
 }

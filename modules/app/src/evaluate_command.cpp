@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <memory>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -75,8 +76,30 @@ void evaluate(const std::filesystem::path &run_dir, const std::filesystem::path 
   std::printf("map (%zu points): median distance to floor plan %.1f mm, p90 %.1f mm, completeness %.1f%%\n",
               map.points, map.median_distance_m * 1e3, map.p90_distance_m * 1e3, map.completeness * 100.0);
 
+  // The covariance against the errors, when the run wrote one per pose.
+  std::optional<slam::CovarianceConsistency> consistency;
+  if (std::filesystem::exists(run_dir / "covariance.csv")) {
+    const auto rows = io::read_covariance_csv(run_dir / "covariance.csv");
+    if (rows.size() != estimate.size()) {
+      throw std::runtime_error((run_dir / "covariance.csv").string() + ": " + std::to_string(rows.size()) +
+                               " rows for " + std::to_string(estimate.size()) + " poses in trajectory.tum");
+    }
+    std::vector<Eigen::Matrix3d> covariances;
+    for (const io::CovarianceRecord &row : rows) covariances.push_back(row.covariance);
+    consistency = slam::covariance_consistency(estimate, truth, covariances);
+    std::printf(
+        "covariance (%d frames): mean NEES %.1f (consistent: ~3), %.1f%% of positions inside their 95%% "
+        "ellipse\n",
+        consistency->frames, consistency->mean_nees, consistency->inside_95_share * 100.0);
+  }
+
   nlohmann::json out;
   out["ate"] = to_json(slam_error, frame_of[slam_error.max_frame] + 1);
+  if (consistency) {
+    out["covariance"] = {{"frames", consistency->frames},
+                         {"mean_nees", consistency->mean_nees},
+                         {"inside_95_share", consistency->inside_95_share}};
+  }
   out["odometry_ate"] = to_json(odometry_error, frame_of[odometry_error.max_frame] + 1);
   out["map"] = {{"points", map.points},
                 {"median_distance_m", map.median_distance_m},

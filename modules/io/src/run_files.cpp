@@ -80,6 +80,39 @@ std::vector<MapPointRecord> read_map_csv(const std::filesystem::path &file) {
   return points;
 }
 
+std::vector<CovarianceRecord> read_covariance_csv(const std::filesystem::path &file) {
+  std::ifstream in(file);
+  if (!in) throw std::runtime_error("cannot open " + file.string());
+  std::vector<CovarianceRecord> rows;
+  std::string line;
+  int number = 0;
+  while (std::getline(in, line)) {
+    ++number;
+    if (number == 1 || line.find_first_not_of(" \t\r") == std::string::npos) continue;  // header
+    const auto where = file.string() + ":" + std::to_string(number) + ": ";
+    const auto fields = detail::split_fields(line, true);
+    if (fields.size() != 8)
+      throw std::runtime_error(where + "expected frame,t and 6 covariance terms, got '" + line + "'");
+    CovarianceRecord row;
+    long frame = 0;
+    if (auto error = detail::parse_integer(fields[0], "frame", frame))
+      throw std::runtime_error(where + *error);
+    if (auto error = detail::parse_finite(fields[1], "t", row.t_s)) throw std::runtime_error(where + *error);
+    static constexpr const char *kNames[] = {"xx_m2",      "xy_m2",      "yy_m2",
+                                             "xyaw_m_rad", "yyaw_m_rad", "yawyaw_rad2"};
+    double terms[6] = {};
+    for (int k = 0; k < 6; ++k) {
+      if (auto error = detail::parse_finite(fields[static_cast<std::size_t>(k) + 2], kNames[k], terms[k]))
+        throw std::runtime_error(where + *error);
+    }
+    row.frame = static_cast<int>(frame);
+    row.covariance << terms[0], terms[1], terms[3], terms[1], terms[2], terms[4], terms[3], terms[4],
+        terms[5];
+    rows.push_back(row);
+  }
+  return rows;
+}
+
 void write_text_file(const std::filesystem::path &file, const std::string &text) {
   std::ofstream out = open_for_writing(file);
   out << text;

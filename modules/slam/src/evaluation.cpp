@@ -1,9 +1,14 @@
 #include "omnislam/slam/evaluation.hpp"
 
+#include <Eigen/Cholesky>
+#include <Eigen/LU>
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <numbers>
 #include <stdexcept>
+
+#include "omnislam/slam/planar_pose.hpp"
 
 namespace omnislam::slam {
 namespace {
@@ -76,6 +81,35 @@ MapError map_error(const Points2 &map_points, const std::vector<Segment2> &floor
   }
   error.completeness = total > 0.0 ? covered / total : 0.0;
   return error;
+}
+
+CovarianceConsistency covariance_consistency(const std::vector<Eigen::Isometry2d> &estimate,
+                                             const std::vector<Eigen::Isometry2d> &truth,
+                                             const std::vector<Eigen::Matrix3d> &covariances) {
+  if (estimate.size() != truth.size() || estimate.size() != covariances.size())
+    throw std::invalid_argument("covariance_consistency: sequences of different lengths");
+  constexpr double kChiSquare95TwoDof = 5.991;
+  CovarianceConsistency result;
+  double nees_sum = 0.0;
+  int inside = 0;
+  for (std::size_t i = 0; i < estimate.size(); ++i) {
+    const Eigen::Matrix3d &P = covariances[i];
+    const Eigen::FullPivLU<Eigen::Matrix3d> lu(P);
+    if (!lu.isInvertible() || !P.allFinite()) continue;
+    const Eigen::Vector2d dp = estimate[i].translation() - truth[i].translation();
+    const double dyaw =
+        std::remainder(yaw_rad_of(estimate[i]) - yaw_rad_of(truth[i]), 2.0 * std::numbers::pi);
+    const Eigen::Vector3d e(dp.x(), dp.y(), dyaw);
+    nees_sum += e.dot(lu.solve(e));
+    const Eigen::Matrix2d P_xy = P.topLeftCorner<2, 2>();
+    if (dp.dot(P_xy.ldlt().solve(dp)) <= kChiSquare95TwoDof) ++inside;
+    ++result.frames;
+  }
+  if (result.frames > 0) {
+    result.mean_nees = nees_sum / result.frames;
+    result.inside_95_share = static_cast<double>(inside) / result.frames;
+  }
+  return result;
 }
 
 }  // namespace omnislam::slam

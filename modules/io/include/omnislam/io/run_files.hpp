@@ -1,5 +1,6 @@
 #pragma once
 
+#include <Eigen/Core>
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -29,6 +30,17 @@ void write_map_ply(const std::filesystem::path &file, const std::vector<MapPoint
 
 /// Reads map.csv back (for `omnislam evaluate`); errors name file:line.
 [[nodiscard]] std::vector<MapPointRecord> read_map_csv(const std::filesystem::path &file);
+
+/// One row of a run's covariance.csv: a frame's (x, y, yaw) covariance in the map frame.
+struct CovarianceRecord {
+  int frame = 0;
+  double t_s = 0.0;
+  Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
+};
+
+/// Reads covariance.csv (`frame,t,xx_m2,xy_m2,yy_m2,xyaw_m_rad,yyaw_m_rad,yawyaw_rad2`);
+/// throws std::runtime_error naming the file and line of a bad row.
+[[nodiscard]] std::vector<CovarianceRecord> read_covariance_csv(const std::filesystem::path &file);
 
 /// Writes `text` to `file` (creating or replacing it).
 void write_text_file(const std::filesystem::path &file, const std::string &text);

@@ -25,6 +25,19 @@ struct TrajectoryError {
 [[nodiscard]] TrajectoryError trajectory_error(const std::vector<Eigen::Isometry2d> &estimate,
                                                const std::vector<Eigen::Isometry2d> &truth);
 
+/// Whether a run's covariances describe its errors (issue 13, "honest covariance").
+struct CovarianceConsistency {
+  int frames = 0;                ///< frames with an invertible covariance (the first, P = 0, is not)
+  double mean_nees = 0.0;        ///< of (x, y, yaw): about 3 when the covariance is consistent
+  double inside_95_share = 0.0;  ///< positions inside their own 95% ellipse (0.95 when consistent)
+};
+
+/// NEES e^T P^-1 e of each frame's (x, y, yaw) error (yaw wrapped) and the share of positions
+/// with e_xy^T P_xy^-1 e_xy within the chi-square 95% bound of 2 degrees of freedom.
+[[nodiscard]] CovarianceConsistency covariance_consistency(const std::vector<Eigen::Isometry2d> &estimate,
+                                                           const std::vector<Eigen::Isometry2d> &truth,
+                                                           const std::vector<Eigen::Matrix3d> &covariances);
+
 struct Segment2 {
   Point2 a = Point2::Zero();
   Point2 b = Point2::Zero();
