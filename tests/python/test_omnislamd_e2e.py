@@ -87,6 +87,9 @@ def test_subscriber_gets_every_pose_equal_to_replay(tmp_path):
     profiles = [line for line in lines if line.startswith("profile ")]
     assert profiles and "frames_out=37 dropped=0" in profiles[-1]
     assert (tmp_path / "service" / "trajectory.tum").read_bytes() == (replay / "trajectory.tum").read_bytes()
+    # The occupancy grid in nav2_map_server's files, written at shutdown: the replay's.
+    for name in ("map.yaml", "map.pgm"):
+        assert (tmp_path / "service" / name).read_bytes() == (replay / name).read_bytes()
 
 
 def test_sigterm_drains_publishes_final_state_and_exits_0(tmp_path):

@@ -18,10 +18,13 @@
 #include "frame_record.hpp"
 #include "omnislam/dds/odometry_reader.hpp"
 #include "omnislam/dds/publisher.hpp"
+#include "omnislam/grid/occupancy_grid.hpp"
 #include "omnislam/io/config.hpp"
+#include "omnislam/io/grid_files.hpp"
 #include "omnislam/pipeline/pipeline.hpp"
 #include "rig_check.hpp"
 #include "run_outputs.hpp"
+#include "scan_rays.hpp"
 #include "service_input.hpp"
 #include "service_state.hpp"
 #include "service_supervisor.hpp"
@@ -144,6 +147,7 @@ int run_service(const std::string &config_file) {
   const bool expects_odometry = service.input.odometry != "none";
 
   RunRecord run;
+  grid::OccupancyGrid occupancy;          // written beside the run files (output_dir)
   std::optional<FrameRecord> last_frame;  // for the final snapshot
   pipeline::Sinks sinks;
   sinks.frame = [&](const pipeline::Frame &frame) {
@@ -180,7 +184,11 @@ int run_service(const std::string &config_file) {
     last_frame = frame_record(frame);
     if (frame.state_due && snapshots)
       snapshots->submit(make_snapshot(*last_frame, *frame.map, frame.map_integrations, n, config_hash));
-    if (!service.output_dir.empty()) run.frames.push_back(*last_frame);
+    if (!service.output_dir.empty()) {
+      run.frames.push_back(*last_frame);
+      if (!frame.skipped())
+        occupancy.add_scan(frame.estimate.T_map_base, scan_rays(frame.scan, config.scan.camera));
+    }
   };
   sinks.profile = [&](const pipeline::ProfileSnapshot &profile) {
     if (publisher) publisher->profile(system_time_s(), profile);
@@ -243,6 +251,9 @@ int run_service(const std::string &config_file) {
     for (const FrameRecord &f : run.frames)
       run.odometry_map.push_back(run.frames.front().T_odom_base.inverse() * f.T_odom_base);
     OutputWriter(service.output_dir).write_all(run, pipeline.slam().map(), info);
+    const grid::GridImage grid_image = occupancy.image();
+    if (grid_image.width > 0)
+      io::write_nav2_map(std::filesystem::path(service.output_dir) / "map.yaml", grid_image);
   }
   if (odometry && odometry->rejected() > 0)
     spdlog::warn("{} odometry samples on {} had a non-finite stamp or pose and were dropped",
