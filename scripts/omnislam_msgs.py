@@ -96,6 +96,24 @@ class Odometry_(IdlStruct, typename="nav_msgs::msg::dds_::Odometry_"):
 
 @dataclass
 @annotate.final
+class MapMetaData_(IdlStruct, typename="nav_msgs::msg::dds_::MapMetaData_"):
+    map_load_time: Time_
+    resolution: types.float32
+    width: types.uint32
+    height: types.uint32
+    origin: Pose_
+
+
+@dataclass
+@annotate.final
+class OccupancyGrid_(IdlStruct, typename="nav_msgs::msg::dds_::OccupancyGrid_"):
+    header: Header_
+    info: MapMetaData_
+    data: types.sequence[types.int8]
+
+
+@dataclass
+@annotate.final
 class PointField_(IdlStruct, typename="sensor_msgs::msg::dds_::PointField_"):
     name: str
     offset: types.uint32

@@ -90,6 +90,16 @@ def test_subscriber_gets_every_pose_equal_to_replay(tmp_path):
     # The occupancy grid in nav2_map_server's files, written at shutdown: the replay's.
     for name in ("map.yaml", "map.pgm"):
         assert (tmp_path / "service" / name).read_bytes() == (replay / name).read_bytes()
+    # ... and on rt/map (nav_msgs/OccupancyGrid): the last grid is the one in map.pgm.
+    grids = [line for line in lines if line.startswith("grid ")]
+    assert grids, out
+    fields = dict(field.split("=") for field in grids[-1].split()[2:])
+    pgm = (replay / "map.pgm").read_bytes().split(b"\n", 3)
+    width, height = map(int, pgm[1].split())
+    shades = pgm[3]
+    assert (int(fields["width"]), int(fields["height"])) == (width, height)
+    assert int(fields["occupied"]) == shades.count(0) and int(fields["free"]) == shades.count(254)
+    assert int(fields["unknown"]) == shades.count(205)
 
 
 def test_sigterm_drains_publishes_final_state_and_exits_0(tmp_path):

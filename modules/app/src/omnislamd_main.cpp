@@ -147,7 +147,7 @@ int run_service(const std::string &config_file) {
   const bool expects_odometry = service.input.odometry != "none";
 
   RunRecord run;
-  grid::OccupancyGrid occupancy;          // written beside the run files (output_dir)
+  grid::OccupancyGrid occupancy;          // rt/map, and map.yaml + map.pgm in output_dir
   std::optional<FrameRecord> last_frame;  // for the final snapshot
   pipeline::Sinks sinks;
   sinks.frame = [&](const pipeline::Frame &frame) {
@@ -175,20 +175,22 @@ int run_service(const std::string &config_file) {
     }
     if (frame.dropped_before > 0)
       spdlog::debug("{} frames dropped before frame {}", frame.dropped_before, frame.sequence);
+    const bool gridded = publisher || !service.output_dir.empty();
+    if (gridded && !frame.skipped())
+      occupancy.add_scan(frame.estimate.T_map_base, scan_rays(frame.scan, config.scan.camera));
     if (publisher) {
       publisher->pose(frame.stamp_s, frame.estimate.T_map_base, frame.estimate.covariance);
       publisher->scan(frame.stamp_s, frame.scan);
-      if (frame.map) publisher->map(frame.stamp_s, *frame.map);
+      if (frame.map) {  // the point map and the occupancy grid, at pipeline.map_rate_hz
+        publisher->map(frame.stamp_s, *frame.map);
+        if (const grid::GridImage image = occupancy.image(); image.width > 0) publisher->grid(frame.stamp_s, image);
+      }
     }
     if (frame.map) counts.map_points.store(frame.map->size(), std::memory_order_relaxed);
     last_frame = frame_record(frame);
     if (frame.state_due && snapshots)
       snapshots->submit(make_snapshot(*last_frame, *frame.map, frame.map_integrations, n, config_hash));
-    if (!service.output_dir.empty()) {
-      run.frames.push_back(*last_frame);
-      if (!frame.skipped())
-        occupancy.add_scan(frame.estimate.T_map_base, scan_rays(frame.scan, config.scan.camera));
-    }
+    if (!service.output_dir.empty()) run.frames.push_back(*last_frame);
   };
   sinks.profile = [&](const pipeline::ProfileSnapshot &profile) {
     if (publisher) publisher->profile(system_time_s(), profile);
@@ -242,6 +244,8 @@ int run_service(const std::string &config_file) {
   }
   if (publisher) {
     publisher->map(last_stamp, pipeline.slam().map().points());  // the final state
+    if (const grid::GridImage final_grid = occupancy.image(); final_grid.width > 0)
+      publisher->grid(last_stamp, final_grid);
     publisher->status(status);
     publisher->flush(2.0);
   }

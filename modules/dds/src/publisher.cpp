@@ -47,6 +47,27 @@ Publisher::Publisher(const Participant &participant) {
   profile_ =
       create_endpoint(p, omnislam_msg_dds__StageProfile__desc, "rt/omnislam/profile", kProfileQos, true);
   status_ = create_endpoint(p, omnislam_msg_dds__Status__desc, "rt/omnislam/status", kStatusQos, true);
+  grid_ = create_endpoint(p, nav_msgs_msg_dds__OccupancyGrid__desc, "rt/map", kGridQos, true);
+  grid_metadata_ = create_endpoint(p, nav_msgs_msg_dds__MapMetaData__desc, "rt/map_metadata", kGridQos, true);
+}
+
+void Publisher::grid(double stamp_s, const grid::GridImage &image) {
+  nav_msgs_msg_dds__MapMetaData_ info{};
+  info.map_load_time = to_time(stamp_s);
+  info.resolution = static_cast<float>(image.resolution_m);
+  info.width = static_cast<uint32_t>(image.width);
+  info.height = static_cast<uint32_t>(image.height);
+  info.origin.position = {image.origin_m.x(), image.origin_m.y(), 0.0};
+  info.origin.orientation = {0.0, 0.0, 0.0, 1.0};
+  nav_msgs_msg_dds__OccupancyGrid_ msg{};
+  msg.header = header(stamp_s, "map");
+  msg.info = info;
+  std::vector<int8_t> cells(image.cells.begin(), image.cells.end());
+  msg.data._buffer = cells.data();
+  msg.data._length = msg.data._maximum = static_cast<uint32_t>(cells.size());
+  msg.data._release = false;
+  write(grid_, &msg, "rt/map");
+  write(grid_metadata_, &info, "rt/map_metadata");
 }
 
 void Publisher::pose(double stamp_s, const Eigen::Isometry2d &T_map_base, const Eigen::Matrix3d &covariance) {
@@ -167,7 +188,7 @@ bool Publisher::wait_for_readers(int readers, double timeout_s) const {
 
 void Publisher::flush(double timeout_s) const {
   const auto timeout = static_cast<dds_duration_t>(timeout_s * 1e9);
-  for (const dds_entity_t writer : {pose_, map_, profile_, status_})
+  for (const dds_entity_t writer : {pose_, map_, profile_, status_, grid_, grid_metadata_})
     static_cast<void>(dds_wait_for_acks(writer, timeout));
 }
 

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "omnislam/dds/participant.hpp"
+#include "omnislam/grid/occupancy_grid.hpp"
 #include "omnislam/pipeline/profiler.hpp"
 #include "omnislam/slam/point_map.hpp"
 #include "omnislam/stereo/local_scan.hpp"
@@ -52,6 +53,8 @@ class Publisher {
   /// sensor_msgs/LaserScan in "base_link": 360 beams of 1 degree from 0, the nearest point
   /// of each; +inf where there is none.
   void scan(double stamp_s, const stereo::LocalScan &scan);
+  /// rt/map (nav_msgs/OccupancyGrid) and rt/map_metadata (nav_msgs/MapMetaData), frame "map".
+  void grid(double stamp_s, const grid::GridImage &image);
   /// omnislam/StageProfile.
   void profile(double stamp_s, const pipeline::ProfileSnapshot &profile);
   /// omnislam/Status (transient-local: late joiners get the last one).
@@ -63,7 +66,7 @@ class Publisher {
   void flush(double timeout_s) const;
 
  private:
-  std::int32_t pose_ = 0, map_ = 0, scan_ = 0, profile_ = 0, status_ = 0;
+  std::int32_t pose_ = 0, map_ = 0, scan_ = 0, profile_ = 0, status_ = 0, grid_ = 0, grid_metadata_ = 0;
 };
 
 }  // namespace omnislam::dds
