@@ -96,6 +96,27 @@ class Odometry_(IdlStruct, typename="nav_msgs::msg::dds_::Odometry_"):
 
 @dataclass
 @annotate.final
+class Transform_(IdlStruct, typename="geometry_msgs::msg::dds_::Transform_"):
+    translation: Vector3_
+    rotation: Quaternion_
+
+
+@dataclass
+@annotate.final
+class TransformStamped_(IdlStruct, typename="geometry_msgs::msg::dds_::TransformStamped_"):
+    header: Header_
+    child_frame_id: str
+    transform: Transform_
+
+
+@dataclass
+@annotate.final
+class TFMessage_(IdlStruct, typename="tf2_msgs::msg::dds_::TFMessage_"):
+    transforms: types.sequence[TransformStamped_]
+
+
+@dataclass
+@annotate.final
 class MapMetaData_(IdlStruct, typename="nav_msgs::msg::dds_::MapMetaData_"):
     map_load_time: Time_
     resolution: types.float32

@@ -197,3 +197,27 @@ TEST_CASE("config: the installed defaults (deploy/*.yaml) load", "[io][config]")
   const omnislam::io::Config thesis = omnislam::io::load_config(deploy / "thesis-2008.yaml");
   CHECK(thesis.slam.target == omnislam::slam::RegistrationTarget::kPreviousScan);
 }
+
+TEST_CASE("config: dds.tf frames, rate and future dating; bad values name the key", "[io][config]") {
+  const omnislam::io::Config defaults =
+      omnislam::io::load_config(write_file("tf_default.yaml", "dds:\n  domain_id: 3\n"));
+  CHECK(defaults.service.dds.tf.enabled);
+  CHECK(defaults.service.dds.tf.map_frame == "map");
+  CHECK(defaults.service.dds.tf.odom_frame == "odom");
+  CHECK(defaults.service.dds.tf.base_frame == "base_link");
+  CHECK_FALSE(defaults.service.dds.tf.publish_odom_to_base);
+  CHECK(defaults.service.dds.tf.rate_hz == 20.0);
+  CHECK(defaults.service.dds.tf.future_dating_s == 0.1);
+  const omnislam::io::Config set = omnislam::io::load_config(
+      write_file("tf_set.yaml",
+                 "dds:\n  tf: {map_frame: world, publish_odom_to_base: true, rate_hz: 50, "
+                 "future_dating_s: 0.2}\n"));
+  CHECK(set.service.dds.tf.map_frame == "world");
+  CHECK(set.service.dds.tf.publish_odom_to_base);
+  CHECK(set.service.dds.tf.rate_hz == 50.0);
+  CHECK(set.service.dds.tf.future_dating_s == 0.2);
+  CHECK_THROWS_WITH(omnislam::io::load_config(write_file("tf_rate.yaml", "dds:\n  tf:\n    rate_hz: 0\n")),
+                    Catch::Contains("tf_rate.yaml:3:") && Catch::Contains("rate_hz"));
+  CHECK_THROWS_WITH(omnislam::io::load_config(write_file("tf_key.yaml", "dds:\n  tf:\n    rate: 10\n")),
+                    Catch::Contains("tf_key.yaml:3:") && Catch::Contains("rate"));
+}

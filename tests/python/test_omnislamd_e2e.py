@@ -148,3 +148,49 @@ def test_omnislam_echo_prints_pose_and_status(tmp_path):
     status.send_signal(signal.SIGINT)
     out, _ = status.communicate(timeout=30)
     assert 'state=stopped in=37 out=37 dropped=0 error=""' in out.splitlines()[-1]
+
+
+def test_tf_map_to_odom_at_20_hz_stamped_ahead(tmp_path):
+    """rt/tf (tf2_msgs/TFMessage): map -> odom after every frame and at >= 20 Hz between
+    frames, stamped future_dating_s ahead; composed with the frame's odometry it is the
+    frame's map pose."""
+    domain = domain_id(1)
+    sub = start_subscriber(domain)
+    config = tmp_path / "omnislamd.yaml"
+    config.write_text(f"""
+input: {{source: dataset, path: {DATASET}, rate_hz: 10}}
+pipeline: {{mode: replay}}
+dds: {{domain_id: {domain}, wait_for_subscribers: 1, wait_timeout_s: 20, tf: {{rate_hz: 20, future_dating_s: 0.1}}}}
+""")
+    service = subprocess.run([os.environ["OMNISLAMD_BIN"], "--config", str(config)], capture_output=True, text=True,
+                             env=dds_env(), timeout=120)
+    assert service.returncode == 0, service.stderr + service.stdout
+    out, err = sub.communicate(timeout=60)
+    assert sub.returncode == 0, err
+    lines = out.splitlines()
+    poses = {round(float(f[1]), 6): (float(f[2][2:]), float(f[3][2:]), float(f[4][4:]))
+             for f in (line.split() for line in lines if line.startswith("pose "))}
+    tfs = [line.split() for line in lines if line.startswith("tf ")]
+    assert len(poses) == 37
+    stamps = [float(f[1]) for f in tfs]
+    assert all(f[2] == "map->odom" for f in tfs)
+    # Between the first and the last frame (3.6 s, played at the recorded 10 Hz): at least
+    # 20 a second, and the stamps never run backwards.
+    span = max(poses) - min(poses)
+    inside = [s for s in stamps if min(poses) + 0.1 <= s <= max(poses) + 0.1]
+    print(f"rt/tf: {len(inside)} messages over {span:.1f} s of data: {len(inside) / span:.1f} Hz")
+    assert len(inside) >= 20 * span, (len(inside), span)
+    assert all(b >= a - 1e-9 for a, b in zip(stamps, stamps[1:])), stamps
+    # Every frame's own message is stamped 0.1 s ahead of it, and with the frame's odometry
+    # (the dataset's odometry.tum) gives back the frame's pose.
+    odometry = read_tum(DATASET / "odometry.tum")
+    by_stamp = {round(float(f[1]), 6): f for f in tfs}
+    for t, (x, y, yaw) in poses.items():
+        f = by_stamp[round(t + 0.1, 6)]
+        mx, my, myaw = float(f[3][2:]), float(f[4][2:]), float(f[5][4:])
+        ox, oy, oyaw = odometry[round(t, 6)]
+        cx = mx + math.cos(myaw) * ox - math.sin(myaw) * oy
+        cy = my + math.sin(myaw) * ox + math.cos(myaw) * oy
+        assert abs(cx - x) < 1e-6 and abs(cy - y) < 1e-6
+        assert abs(math.remainder(myaw + oyaw - yaw, 2 * math.pi)) < 1e-6
+    assert min(stamps) >= min(poses) + 0.1 - 1e-6

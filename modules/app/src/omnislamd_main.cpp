@@ -29,6 +29,7 @@
 #include "service_state.hpp"
 #include "service_supervisor.hpp"
 #include "snapshot_writer.hpp"
+#include "tf_broadcaster.hpp"
 
 namespace {
 
@@ -114,10 +115,12 @@ int run_service(const std::string &config_file) {
 
   std::optional<dds::Participant> participant;
   std::optional<dds::Publisher> publisher;
+  std::optional<TfBroadcaster> tf;
   std::shared_ptr<dds::OdometryReader> odometry;
   if (service.dds.enabled) {
     participant.emplace(dds::DdsConfig{service.dds.domain_id, service.dds.config});
     publisher.emplace(*participant);
+    if (service.dds.tf.enabled) tf.emplace(*participant, service.dds.tf, service.input.odometry != "none");
     if (service.input.odometry == "dds") {
       odometry = std::make_shared<dds::OdometryReader>(
           *participant, service.input.odometry_topic,
@@ -178,12 +181,16 @@ int run_service(const std::string &config_file) {
     const bool gridded = publisher || !service.output_dir.empty();
     if (gridded && !frame.skipped())
       occupancy.add_scan(frame.estimate.T_map_base, scan_rays(frame.scan, config.scan.camera));
+    if (tf)
+      tf->update(frame.stamp_s, frame.estimate.T_map_base,
+                 frame.has_odometry ? std::optional(frame.T_odom_base) : std::nullopt);
     if (publisher) {
       publisher->pose(frame.stamp_s, frame.estimate.T_map_base, frame.estimate.covariance);
       publisher->scan(frame.stamp_s, frame.scan);
       if (frame.map) {  // the point map and the occupancy grid, at pipeline.map_rate_hz
         publisher->map(frame.stamp_s, *frame.map);
-        if (const grid::GridImage image = occupancy.image(); image.width > 0) publisher->grid(frame.stamp_s, image);
+        if (const grid::GridImage image = occupancy.image(); image.width > 0)
+          publisher->grid(frame.stamp_s, image);
       }
     }
     if (frame.map) counts.map_points.store(frame.map->size(), std::memory_order_relaxed);

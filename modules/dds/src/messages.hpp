@@ -69,6 +69,8 @@ inline constexpr TopicQos kProfileQos{true, Durability::kVolatile, 10};
 inline constexpr TopicQos kStatusQos{true, Durability::kTransientLocal, 1};
 /// rt/map and rt/map_metadata as nav2_map_server publishes them: a late subscriber gets the last.
 inline constexpr TopicQos kGridQos{true, Durability::kTransientLocal, 1};
+/// rt/tf as tf2's TransformBroadcaster writes it.
+inline constexpr TopicQos kTfQos{true, Durability::kVolatile, 100};
 /// rt/odom is read best effort: a best-effort reader matches reliable writers and the
 /// sensor-data QoS (best effort) that base drivers use; a reliable one matches only the former.
 inline constexpr TopicQos kOdomQos{false, Durability::kVolatile, 50};

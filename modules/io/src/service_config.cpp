@@ -1,5 +1,6 @@
 #include <initializer_list>
 #include <string>
+#include <utility>
 
 #include "omnislam/io/config.hpp"
 #include "yaml_fields.hpp"
@@ -61,6 +62,22 @@ void read_dds(YamlSection &section, DdsSectionConfig &dds) {
   section.read("wait_for_subscribers", dds.wait_for_subscribers);
   section.read("wait_timeout_s", dds.wait_timeout_s);
   if (dds.domain_id < 0 || dds.domain_id > 232) section.fail("domain_id", "must be in 0..232");
+  read_section(section, "tf", [&](YamlSection &tf) {
+    tf.read("enabled", dds.tf.enabled);
+    tf.read("map_frame", dds.tf.map_frame);
+    tf.read("odom_frame", dds.tf.odom_frame);
+    tf.read("base_frame", dds.tf.base_frame);
+    tf.read("publish_odom_to_base", dds.tf.publish_odom_to_base);
+    tf.read("rate_hz", dds.tf.rate_hz);
+    tf.read("future_dating_s", dds.tf.future_dating_s);
+    for (const auto &[key, frame] :
+         {std::pair{"map_frame", &dds.tf.map_frame}, std::pair{"odom_frame", &dds.tf.odom_frame},
+          std::pair{"base_frame", &dds.tf.base_frame}})
+      if (frame->empty()) tf.fail(key, "must not be empty");
+    if (!(dds.tf.rate_hz > 0.0) || dds.tf.rate_hz > 1000.0) tf.fail("rate_hz", "must be in (0, 1000]");
+    if (!(dds.tf.future_dating_s >= 0.0) || dds.tf.future_dating_s > 10.0)
+      tf.fail("future_dating_s", "must be in [0, 10]");
+  });
 }
 
 }  // namespace

@@ -11,7 +11,9 @@
 ///            odometry: dataset | dds | none, odometry_topic, odometry_max_extrapolation_s,
 ///            odometry_max_gap_s}
 /// pipeline: {mode: live | replay, queue_capacity, map_rate_hz, profile_period_s, profile_window}
-/// dds:      {enabled, domain_id, config, wait_for_subscribers, wait_timeout_s}
+/// dds:      {enabled, domain_id, config, wait_for_subscribers, wait_timeout_s,
+///            tf: {enabled, map_frame, odom_frame, base_frame, publish_odom_to_base,
+///                 rate_hz, future_dating_s}}
 /// service:  {output_dir, stage_timeout_s}
 /// ```
 
@@ -53,6 +55,18 @@ struct DdsSectionConfig {
   std::string config;            ///< Cyclone XML file; empty: CYCLONEDDS_URI or Cyclone's default
   int wait_for_subscribers = 0;  ///< before starting, wait for this many pose readers ...
   double wait_timeout_s = 10.0;  ///< ... at most this long (then start anyway, with a warning)
+  /// rt/tf (tf2_msgs/TFMessage), REP-105: map -> odom from each frame's map pose and its
+  /// odometry pose, re-sent at rate_hz between frames, stamped future_dating_s ahead (as
+  /// slam_toolbox's transform_timeout) so that TF users can look up the data's time.
+  struct Tf {
+    bool enabled = true;
+    std::string map_frame = "map";
+    std::string odom_frame = "odom";
+    std::string base_frame = "base_link";
+    bool publish_odom_to_base = false;  ///< odom -> base_link too (a robot without a base driver's TF)
+    double rate_hz = 20.0;
+    double future_dating_s = 0.1;
+  } tf;
 };
 
 struct ServiceConfig {
