@@ -1,4 +1,4 @@
-"""Small readers used by the dataset tests."""
+"""Small readers and image helpers used by the tests."""
 from __future__ import annotations
 
 import csv
@@ -91,3 +91,22 @@ def floor_wall_edge_errors(img: np.ndarray, segments: np.ndarray, n_walls: int, 
             r = radii[j] + ((near + far) / 2 - prof[j]) / (prof[j + 1] - prof[j]) * 0.02
             errors[lobe.name].append(r - pred)
     return {k: np.array(v) for k, v in errors.items()}
+
+
+def shifted(image, du, dv):
+    """The image moved by (du, dv) px, bilinear, black where nothing was (the whole rig's
+    picture moves when the mirror's axis is off the camera's)."""
+    iu, iv = int(np.floor(du)), int(np.floor(dv))
+    fu, fv = du - iu, dv - iv
+
+    def take(oy, ox):  # out[y, x] = image[y - oy, x - ox], zero outside
+        out = np.zeros_like(image, dtype=float)
+        h, w = image.shape
+        ys, xs = slice(max(0, oy), min(h, h + oy)), slice(max(0, ox), min(w, w + ox))
+        yi, xi = slice(max(0, -oy), min(h, h - oy)), slice(max(0, -ox), min(w, w - ox))
+        out[ys, xs] = image[yi, xi]
+        return out
+
+    out = ((1 - fu) * (1 - fv) * take(iv, iu) + fu * (1 - fv) * take(iv, iu + 1)
+           + (1 - fu) * fv * take(iv + 1, iu) + fu * fv * take(iv + 1, iu + 1))
+    return np.clip(np.rint(out), 0, 255).astype(np.uint8)

@@ -6,13 +6,12 @@ import pathlib
 import re
 import shutil
 import subprocess
-import sys
 
 import numpy as np
+from helpers import shifted
+from omnislam_render.pngio import read_png, to_gray, write_png_gray
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
-sys.path.insert(0, str(ROOT / "scripts"))
-from omnislam_render.pngio import read_png, to_gray, write_png_gray  # noqa: E402
 
 
 def omnislam():
@@ -21,25 +20,6 @@ def omnislam():
 
 def run(*args):
     return subprocess.run([omnislam(), *map(str, args)], capture_output=True, text=True)
-
-
-def shifted(image, du, dv):
-    """The image moved by (du, dv) px, bilinear, black where nothing was (the whole rig's
-    picture moves when the mirror's axis is off the camera's)."""
-    iu, iv = int(np.floor(du)), int(np.floor(dv))
-    fu, fv = du - iu, dv - iv
-
-    def take(oy, ox):  # out[y, x] = image[y - oy, x - ox], zero outside
-        out = np.zeros_like(image, dtype=float)
-        h, w = image.shape
-        ys, xs = slice(max(0, oy), min(h, h + oy)), slice(max(0, ox), min(w, w + ox))
-        yi, xi = slice(max(0, -oy), min(h, h - oy)), slice(max(0, -ox), min(w, w - ox))
-        out[ys, xs] = image[yi, xi]
-        return out
-
-    out = ((1 - fu) * (1 - fv) * take(iv, iu) + fu * (1 - fv) * take(iv, iu + 1)
-           + (1 - fu) * fv * take(iv + 1, iu) + fu * fv * take(iv + 1, iu + 1))
-    return np.clip(np.rint(out), 0, 255).astype(np.uint8)
 
 
 def test_calibrate_rim_recovers_an_offset_centre(tmp_path):

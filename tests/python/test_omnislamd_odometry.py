@@ -76,13 +76,14 @@ class OdometryPublisher:
         self.thread.join()
 
 
-def test_odometry_gap_is_noticed_counted_and_the_run_goes_on(tmp_path):
+def run_standing_still(tmp_path, frames: int, publisher: OdometryPublisher, domain: int) -> str:
+    """omnislamd over `frames` copies of sim-room-37's frame 1 at 10 Hz with odometry from
+    DDS, `publisher` running; returns its log (the run must succeed)."""
     images = tmp_path / "images"
     images.mkdir()
     first = REPO / "datasets" / "sim-room-37" / "images" / "000001.png"
-    for i in range(40):
+    for i in range(frames):
         shutil.copy(first, images / f"{i:06d}.png")
-    domain = 100 + (os.getpid() * 2 + 7) % 100
     config = tmp_path / "omnislamd.yaml"
     config.write_text(f"""
 input: {{source: directory, path: {images}, rate_hz: 10, odometry: dds}}
@@ -90,7 +91,6 @@ pipeline: {{mode: replay}}
 dds: {{domain_id: {domain}}}
 service: {{output_dir: {tmp_path / 'out'}}}
 """)
-    publisher = OdometryPublisher(domain, gap_from=2.0, gap_to=3.5)
     publisher.start()
     time.sleep(1.0)  # discovery: the first frames find odometry already flowing
     try:
@@ -100,6 +100,12 @@ service: {{output_dir: {tmp_path / 'out'}}}
         publisher.stop()
     log = service.stdout + service.stderr
     assert service.returncode == 0, log
+    return log
+
+
+def test_odometry_gap_is_noticed_counted_and_the_run_goes_on(tmp_path):
+    domain = 100 + (os.getpid() * 2 + 7) % 100
+    log = run_standing_still(tmp_path, 40, OdometryPublisher(domain, gap_from=2.0, gap_to=3.5), domain)
     stopped = next(line for line in log.splitlines() if "stopped:" in line)
     without = int(stopped.split(" skipped, ")[1].split()[0])
     # The 1.5 s gap falls in the 4 s run: ~15 frames at 10 Hz, minus the 0.2 s within which
@@ -117,29 +123,9 @@ service: {{output_dir: {tmp_path / 'out'}}}
 
 def test_a_best_effort_odometry_writer_is_matched(tmp_path):
     """The sensor-data QoS of ROS 2 base drivers (best effort) feeds omnislamd as well."""
-    images = tmp_path / "images"
-    images.mkdir()
-    first = REPO / "datasets" / "sim-room-37" / "images" / "000001.png"
-    for i in range(20):
-        shutil.copy(first, images / f"{i:06d}.png")
     domain = 100 + (os.getpid() * 2 + 9) % 100
-    config = tmp_path / "omnislamd.yaml"
-    config.write_text(f"""
-input: {{source: directory, path: {images}, rate_hz: 10, odometry: dds}}
-pipeline: {{mode: replay}}
-dds: {{domain_id: {domain}}}
-service: {{output_dir: {tmp_path / 'out'}}}
-""")
     publisher = OdometryPublisher(domain, gap_from=1e9, gap_to=1e9, reliable=False)
-    publisher.start()
-    time.sleep(1.0)  # discovery
-    try:
-        service = subprocess.run([os.environ["OMNISLAMD_BIN"], "--config", str(config)], capture_output=True,
-                                 text=True, timeout=120)
-    finally:
-        publisher.stop()
-    log = service.stdout + service.stderr
-    assert service.returncode == 0, log
+    log = run_standing_still(tmp_path, 20, publisher, domain)
     stopped = next(line for line in log.splitlines() if "stopped:" in line)
     assert "20 frames in, 20 out, 0 dropped, 0 skipped" in stopped, log
     # Matched, so odometry flows (an unmatched reader would leave all 20 frames without);

@@ -16,6 +16,8 @@ import time
 from pathlib import Path
 
 import pytest
+from helpers import shifted
+from omnislam_render.pngio import read_png, to_gray, write_png_gray
 
 REPO = Path(__file__).resolve().parents[2]
 DATASET = REPO / "datasets" / "sim-room-37"
@@ -251,11 +253,6 @@ service: {{output_dir: {tmp_path / 'out'}}}
 def test_rig_check_at_start_warns_when_the_rim_is_off_centre(tmp_path, shift):
     """The first live image's mirror rim against camera.center_px: within 0.5 px an info line,
     beyond it a warning in the journal (and the status); the service runs on either way."""
-    import sys
-    sys.path.insert(0, str(REPO / "scripts"))
-    sys.path.insert(0, str(REPO / "tests" / "python"))
-    from omnislam_render.pngio import read_png, to_gray, write_png_gray
-    from test_calibrate_cli import shifted
     images = tmp_path / "images"
     images.mkdir()
     for frame in range(1, 4):

@@ -249,10 +249,10 @@ int run_service(const std::string &config_file) {
     if (!snapshots->last_error().empty()) status.last_error = snapshots->last_error();
     spdlog::info("{} snapshots written to {}", snapshots->written(), snapshots->file().string());
   }
+  const grid::GridImage final_grid = occupancy.image();  // empty when nothing was gridded
   if (publisher) {
     publisher->map(last_stamp, pipeline.slam().map().points());  // the final state
-    if (const grid::GridImage final_grid = occupancy.image(); final_grid.width > 0)
-      publisher->grid(last_stamp, final_grid);
+    if (final_grid.width > 0) publisher->grid(last_stamp, final_grid);
     publisher->status(status);
     publisher->flush(2.0);
   }
@@ -262,9 +262,8 @@ int run_service(const std::string &config_file) {
     for (const FrameRecord &f : run.frames)
       run.odometry_map.push_back(run.frames.front().T_odom_base.inverse() * f.T_odom_base);
     OutputWriter(service.output_dir).write_all(run, pipeline.slam().map(), info);
-    const grid::GridImage grid_image = occupancy.image();
-    if (grid_image.width > 0)
-      io::write_nav2_map(std::filesystem::path(service.output_dir) / "map.yaml", grid_image);
+    if (final_grid.width > 0)
+      io::write_nav2_map(std::filesystem::path(service.output_dir) / "map.yaml", final_grid);
   }
   if (odometry && odometry->rejected() > 0)
     spdlog::warn("{} odometry samples on {} had a non-finite stamp or pose and were dropped",

@@ -118,17 +118,11 @@ std::string profile_csv(const RunRecord &run, bool thesis_timelog) {
   return out.str();
 }
 
-std::string covariance_csv(const RunRecord &run) {
-  std::ostringstream out;
-  out << "frame,t,xx_m2,xy_m2,yy_m2,xyaw_m_rad,yyaw_m_rad,yawyaw_rad2\n";
-  char line[256];
-  for (std::size_t i = 0; i < run.frames.size(); ++i) {
-    const Eigen::Matrix3d &c = run.frames[i].covariance;
-    std::snprintf(line, sizeof line, "%zu,%.6f,%.6e,%.6e,%.6e,%.6e,%.6e,%.6e\n", i + 1, run.frames[i].t_s,
-                  c(0, 0), c(0, 1), c(1, 1), c(0, 2), c(1, 2), c(2, 2));
-    out << line;
-  }
-  return out.str();
+std::vector<io::CovarianceRecord> covariance_records(const RunRecord &run) {
+  std::vector<io::CovarianceRecord> rows;
+  for (std::size_t i = 0; i < run.frames.size(); ++i)
+    rows.push_back({static_cast<int>(i) + 1, run.frames[i].t_s, run.frames[i].covariance});
+  return rows;
 }
 
 std::vector<io::MapPointRecord> map_records(const slam::PointMap &map) {
@@ -171,7 +165,7 @@ void OutputWriter::write_all(const RunRecord &run, const slam::PointMap &map,
   io::write_map_csv(dir_ / "map.csv", records);
   io::write_map_ply(dir_ / "map.ply", records);
   io::write_text_file(dir_ / "profile.csv", profile_csv(run, false));
-  io::write_text_file(dir_ / "covariance.csv", covariance_csv(run));
+  io::write_covariance_csv(dir_ / "covariance.csv", covariance_records(run));
   io::write_text_file(dir_ / "timelog.txt", profile_csv(run, true));
   io::write_text_file(dir_ / "autolocalizacao.txt", thesis_localisation(run));
   io::write_text_file(dir_ / "vetores.txt", thesis_vectors(run));

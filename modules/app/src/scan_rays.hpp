@@ -2,7 +2,6 @@
 
 #include <cmath>
 #include <limits>
-#include <numbers>
 #include <vector>
 
 #include "omnislam/grid/occupancy_grid.hpp"
@@ -24,14 +23,8 @@ namespace omnislam::app {
                               : kNaN;
     rays[static_cast<std::size_t>(column)] = {mirror::column_azimuth_rad(camera, column), kNaN, free_m};
   }
-  // One boundary per column (nearest first): the point's azimuth names its column.
-  const double column_rad = 2.0 * std::numbers::pi / columns;
-  const double offset_rad = camera.azimuth_offset_deg * std::numbers::pi / 180.0;
   for (const stereo::ScanPoint &point : scan.points) {
-    const double turns =
-        std::remainder(point.azimuth_rad - offset_rad - 0.5 * column_rad, 2.0 * std::numbers::pi);
-    const int column = ((static_cast<int>(std::lround(turns / column_rad)) % columns) + columns) % columns;
-    grid::Ray &ray = rays[static_cast<std::size_t>(column)];
+    grid::Ray &ray = rays[static_cast<std::size_t>(point.column)];
     if (!std::isfinite(ray.hit_m) || point.range_m < ray.hit_m) ray.hit_m = point.range_m;
   }
   return rays;

@@ -79,9 +79,8 @@ std::optional<CircleFit> fit_circle(std::span<const Eigen::Vector2d> points) {
   if (!start) return std::nullopt;
   Circle circle = *start;
   std::vector<bool> use(points.size(), true);
-  Eigen::Matrix3d normal = Eigen::Matrix3d::Zero();
   for (int round = 0; round < kRejectionRounds; ++round) {
-    normal = geometric_fit(points, use, circle);
+    geometric_fit(points, use, circle);
     std::vector<double> residuals;
     residuals.reserve(points.size());
     for (const Eigen::Vector2d &point : points)
@@ -93,7 +92,7 @@ std::optional<CircleFit> fit_circle(std::span<const Eigen::Vector2d> points) {
     const double scale = std::max(kMinScalePx, kMadToSigma * median(deviations));
     for (std::size_t i = 0; i < points.size(); ++i) use[i] = std::abs(residuals[i]) <= kInlierScales * scale;
   }
-  normal = geometric_fit(points, use, circle);
+  const Eigen::Matrix3d normal = geometric_fit(points, use, circle);
   CircleFit fit;
   fit.centre_px = circle.centre;
   fit.radius_px = circle.radius;

@@ -42,15 +42,20 @@ double step_radius(const cv::Mat &image, const Eigen::Vector2d &centre, double p
   const auto at = [&](double radius) {
     return sample(image, centre.x() + radius * cos_phi, centre.y() + radius * sin_phi);
   };
-  // Derivative along the ray (central differences over one pixel), signed so that the
+  // The profile, sampled once from half a pixel before the first radius to half a pixel
+  // after the last; its derivative over one pixel (central differences), signed so that the
   // step looked for is positive.
+  constexpr int kPixel = static_cast<int>(1.0 / kSampleStepPx);
+  std::vector<double> profile(static_cast<std::size_t>(samples + kPixel));
+  for (int j = 0; j < samples + kPixel; ++j)
+    profile[static_cast<std::size_t>(j)] = at(first - 0.5 + j * kSampleStepPx);
   const double sign = polarity == Polarity::kDarkOutside ? -1.0 : 1.0;
   int best = -1;
   double best_slope = 0.0;
-  std::vector<double> slopes(static_cast<std::size_t>(samples), std::nan(""));
+  std::vector<double> slopes(static_cast<std::size_t>(samples));
   for (int i = 0; i < samples; ++i) {
-    const double radius = first + i * kSampleStepPx;
-    const double slope = sign * (at(radius + 0.5) - at(radius - 0.5));
+    const double slope =
+        sign * (profile[static_cast<std::size_t>(i + kPixel)] - profile[static_cast<std::size_t>(i)]);
     slopes[static_cast<std::size_t>(i)] = slope;
     if (std::isfinite(slope) && slope > best_slope) best_slope = slope, best = i;
   }

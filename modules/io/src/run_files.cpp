@@ -2,7 +2,10 @@
 
 #include <cstdio>
 #include <fstream>
+#include <functional>
 #include <stdexcept>
+#include <string>
+#include <string_view>
 
 #include "number_fields.hpp"
 
@@ -17,6 +20,29 @@ std::ofstream open_for_writing(const std::filesystem::path &file) {
 
 void finish(std::ofstream &out, const std::filesystem::path &file) {
   if (!out.flush()) throw std::runtime_error("write failed: " + file.string());
+}
+
+// Throws std::runtime_error with the row's file:line prefixed to the message.
+using Fail = std::function<void(const std::string &)>;
+
+// Calls parse(fields, fail) for every row of a CSV file with a header line (blank lines
+// skipped); a row without `field_count` fields fails naming what was expected.
+template <typename Parse>
+void for_each_csv_row(const std::filesystem::path &file, std::size_t field_count, const char *expected,
+                      Parse &&parse) {
+  std::ifstream in(file);
+  if (!in) throw std::runtime_error("cannot open " + file.string());
+  std::string line;
+  int number = 0;
+  while (std::getline(in, line)) {
+    ++number;
+    if (number == 1 || line.find_first_not_of(" \t\r") == std::string::npos) continue;  // header
+    const std::string where = file.string() + ":" + std::to_string(number) + ": ";
+    const Fail fail = [&where](const std::string &message) { throw std::runtime_error(where + message); };
+    const auto fields = detail::split_fields(line, true);
+    if (fields.size() != field_count) fail(std::string("expected ") + expected + ", got '" + line + "'");
+    parse(fields, fail);
+  }
 }
 
 }  // namespace
@@ -56,60 +82,54 @@ void write_map_ply(const std::filesystem::path &file, const std::vector<MapPoint
   finish(out, file);
 }
 
+void write_covariance_csv(const std::filesystem::path &file, const std::vector<CovarianceRecord> &rows) {
+  std::ofstream out = open_for_writing(file);
+  out << "frame,t,xx_m2,xy_m2,yy_m2,xyaw_m_rad,yyaw_m_rad,yawyaw_rad2\n";
+  char line[256];
+  for (const CovarianceRecord &row : rows) {
+    const Eigen::Matrix3d &c = row.covariance;
+    std::snprintf(line, sizeof line, "%d,%.6f,%.6e,%.6e,%.6e,%.6e,%.6e,%.6e\n", row.frame, row.t_s, c(0, 0),
+                  c(0, 1), c(1, 1), c(0, 2), c(1, 2), c(2, 2));
+    out << line;
+  }
+  finish(out, file);
+}
+
 std::vector<MapPointRecord> read_map_csv(const std::filesystem::path &file) {
-  std::ifstream in(file);
-  if (!in) throw std::runtime_error("cannot open " + file.string());
   std::vector<MapPointRecord> points;
-  std::string line;
-  int number = 0;
-  while (std::getline(in, line)) {
-    ++number;
-    if (number == 1 || line.find_first_not_of(" \t\r") == std::string::npos) continue;  // header
-    const auto where = file.string() + ":" + std::to_string(number) + ": ";
-    const auto fields = detail::split_fields(line, true);
-    if (fields.size() != 3) throw std::runtime_error(where + "expected x,y,hits, got '" + line + "'");
+  for_each_csv_row(file, 3, "x,y,hits", [&](const std::vector<std::string_view> &fields, const Fail &fail) {
     MapPointRecord p;
     long hits = 0;
-    if (auto error = detail::parse_finite(fields[0], "x", p.x_m)) throw std::runtime_error(where + *error);
-    if (auto error = detail::parse_finite(fields[1], "y", p.y_m)) throw std::runtime_error(where + *error);
-    if (auto error = detail::parse_integer(fields[2], "hits", hits)) throw std::runtime_error(where + *error);
-    if (hits < 1 || hits > 1000000000) throw std::runtime_error(where + "'hits' must be in 1..1e9");
+    if (auto error = detail::parse_finite(fields[0], "x", p.x_m)) fail(*error);
+    if (auto error = detail::parse_finite(fields[1], "y", p.y_m)) fail(*error);
+    if (auto error = detail::parse_integer(fields[2], "hits", hits)) fail(*error);
+    if (hits < 1 || hits > 1000000000) fail("'hits' must be in 1..1e9");
     p.hits = static_cast<int>(hits);
     points.push_back(p);
-  }
+  });
   return points;
 }
 
 std::vector<CovarianceRecord> read_covariance_csv(const std::filesystem::path &file) {
-  std::ifstream in(file);
-  if (!in) throw std::runtime_error("cannot open " + file.string());
+  static constexpr const char *kTerms[] = {"xx_m2",      "xy_m2",      "yy_m2",
+                                           "xyaw_m_rad", "yyaw_m_rad", "yawyaw_rad2"};
   std::vector<CovarianceRecord> rows;
-  std::string line;
-  int number = 0;
-  while (std::getline(in, line)) {
-    ++number;
-    if (number == 1 || line.find_first_not_of(" \t\r") == std::string::npos) continue;  // header
-    const auto where = file.string() + ":" + std::to_string(number) + ": ";
-    const auto fields = detail::split_fields(line, true);
-    if (fields.size() != 8)
-      throw std::runtime_error(where + "expected frame,t and 6 covariance terms, got '" + line + "'");
-    CovarianceRecord row;
-    long frame = 0;
-    if (auto error = detail::parse_integer(fields[0], "frame", frame))
-      throw std::runtime_error(where + *error);
-    if (auto error = detail::parse_finite(fields[1], "t", row.t_s)) throw std::runtime_error(where + *error);
-    static constexpr const char *kNames[] = {"xx_m2",      "xy_m2",      "yy_m2",
-                                             "xyaw_m_rad", "yyaw_m_rad", "yawyaw_rad2"};
-    double terms[6] = {};
-    for (int k = 0; k < 6; ++k) {
-      if (auto error = detail::parse_finite(fields[static_cast<std::size_t>(k) + 2], kNames[k], terms[k]))
-        throw std::runtime_error(where + *error);
-    }
-    row.frame = static_cast<int>(frame);
-    row.covariance << terms[0], terms[1], terms[3], terms[1], terms[2], terms[4], terms[3], terms[4],
-        terms[5];
-    rows.push_back(row);
-  }
+  for_each_csv_row(file, 8, "frame,t and 6 covariance terms",
+                   [&](const std::vector<std::string_view> &fields, const Fail &fail) {
+                     CovarianceRecord row;
+                     long frame = 0;
+                     if (auto error = detail::parse_integer(fields[0], "frame", frame)) fail(*error);
+                     if (auto error = detail::parse_finite(fields[1], "t", row.t_s)) fail(*error);
+                     double terms[6] = {};
+                     for (std::size_t k = 0; k < 6; ++k) {
+                       if (auto error = detail::parse_finite(fields[k + 2], kTerms[k], terms[k]))
+                         fail(*error);
+                     }
+                     row.frame = static_cast<int>(frame);
+                     row.covariance << terms[0], terms[1], terms[3], terms[1], terms[2], terms[4], terms[3],
+                         terms[4], terms[5];
+                     rows.push_back(row);
+                   });
   return rows;
 }
 

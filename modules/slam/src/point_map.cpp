@@ -32,6 +32,12 @@ PointMap::Box PointMap::Box::everything() {
   return {Point2::Constant(-kInfinity), Point2::Constant(kInfinity)};
 }
 
+PointMap::Box PointMap::Box::around(const Points2 &points) {
+  Box box = nothing();
+  for (const Point2 &p : points) box.add(p);
+  return box;
+}
+
 PointMap::Box PointMap::Box::nothing() { return {Point2::Constant(kInfinity), Point2::Constant(-kInfinity)}; }
 
 PointMap::PointMap(PointMapConfig config, std::vector<MapPoint> points, int integrations)
@@ -44,8 +50,7 @@ void PointMap::integrate(const Points2 &points_map) {
   // Everything this integration changes or checks lies near the scan or near the points
   // removed last time; the index covers that region only, so its cost follows the scan,
   // not the map (a restored map is checked whole once).
-  Box touched = Box::nothing();
-  for (const Point2 &p : points_map) touched.add(p);
+  Box touched = Box::around(points_map);
   for (const Point2 &p : removed_since_filter_) touched.add(p);
   const double reach = config_.fusion_radius_m + 2.0 * config_.noise_radius_m;
   const Box region = check_all_ ? Box::everything() : touched.grown(std::max(reach, config_.local_margin_m));
@@ -104,8 +109,7 @@ void PointMap::integrate(const Points2 &points_map) {
 
 const NearestNeighbors &PointMap::index_near(const Points2 &points_map, double reach_m) {
   if (check_all_) return index_;  // a restored map: the whole map is indexed until it changes
-  Box needed = Box::nothing();
-  for (const Point2 &p : points_map) needed.add(p);
+  const Box needed = Box::around(points_map);
   if (!indexed_.contains(needed.grown(reach_m)))
     index_points_in(needed.grown(std::max(reach_m, config_.local_margin_m)));
   return index_;

@@ -38,8 +38,11 @@ struct CovarianceRecord {
   Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
 };
 
-/// Reads covariance.csv (`frame,t,xx_m2,xy_m2,yy_m2,xyaw_m_rad,yyaw_m_rad,yawyaw_rad2`);
-/// throws std::runtime_error naming the file and line of a bad row.
+/// covariance.csv: header `frame,t,xx_m2,xy_m2,yy_m2,xyaw_m_rad,yyaw_m_rad,yawyaw_rad2`,
+/// one row per frame (the six distinct terms of the symmetric matrix).
+void write_covariance_csv(const std::filesystem::path &file, const std::vector<CovarianceRecord> &rows);
+
+/// Reads covariance.csv back; throws std::runtime_error naming the file and line of a bad row.
 [[nodiscard]] std::vector<CovarianceRecord> read_covariance_csv(const std::filesystem::path &file);
 
 /// Writes `text` to `file` (creating or replacing it).

@@ -73,6 +73,7 @@ class PointMap {
     [[nodiscard]] bool contains(const Box &other) const;
     static Box everything();
     static Box nothing();
+    static Box around(const Points2 &points);  ///< the bounding box of the points
   };
   /// Rebuilds the index over the points inside `region`.
   void index_points_in(const Box &region);

@@ -17,6 +17,7 @@ struct ScanPoint {
   double z_m = 0.0;        ///< above the floor: camera_height_m + height relative to the pinhole
   float inner_row = 0.0f;  ///< matched panorama rows (fractional after sub-pixel refinement)
   float outer_row = 0.0f;
+  int column = 0;  ///< the panorama column the point was found in
 };
 
 /// Counts after each step of the reconstruction, for logs, profiles and tests.
