@@ -15,6 +15,7 @@ namespace omnislam::app {
   record.covariance = frame.estimate.covariance;
   record.skipped = frame.skipped();
   record.integrated = frame.estimate.integrated;
+  record.localized = frame.localized;
   record.attempt = frame.estimate.attempt;
   record.srel_percent = frame.estimate.registration.srel_percent;
   record.iterations = frame.estimate.registration.iterations;

@@ -1,5 +1,6 @@
 #include "replay_command.hpp"
 
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <memory>
@@ -15,6 +16,7 @@
 #include "omnislam/io/dataset.hpp"
 #include "omnislam/io/grid_files.hpp"
 #include "omnislam/io/poses.hpp"
+#include "omnislam/io/snapshot.hpp"
 #include "omnislam/pipeline/pipeline.hpp"
 #include "omnislam/slam/odometry_noise.hpp"
 #include "run_outputs.hpp"
@@ -32,6 +34,8 @@ struct ReplayOptions {
   std::uint64_t seed = 1;
   std::string degrade = "none";
   std::uint64_t degrade_seed = 1;
+  std::string map_file;  ///< a snapshot to localize on (--map, with --localize)
+  bool localize = false;
 };
 
 // Odometry as the robot reports it (the dataset's, or a given TUM or thesis-format file),
@@ -78,7 +82,7 @@ void run_replay(const ReplayOptions &options, std::optional<std::uint64_t> degra
   grid::OccupancyGrid occupancy;
   sinks.frame = [&](const pipeline::Frame &frame) {
     run.frames.push_back(frame_record(frame));
-    if (!frame.skipped())
+    if (!frame.skipped() && frame.localized)
       occupancy.add_scan(frame.estimate.T_map_base, scan_rays(frame.scan, config.scan.camera));
     if (frame.estimate.integrated && frame.map)
       writer.write_thesis_map(static_cast<int>(frame.sequence), *frame.map);
@@ -95,10 +99,26 @@ void run_replay(const ReplayOptions &options, std::optional<std::uint64_t> degra
   source_options.on_skip = [](int frame, const std::string &error) {
     std::fprintf(stderr, "omnislam replay: frame %d skipped: %s\n", frame, error.c_str());
   };
+  if (options.localize) config.slam.localization_only = true;  // the saved map stays as it is
   pipeline::Pipeline pipeline(config.scan, config.slam, pipeline_config, std::move(sinks));
+  if (options.localize) {
+    io::Snapshot snapshot = io::read_snapshot(options.map_file);
+    run.localizing = true;
+    pipeline.relocalize(std::move(snapshot.points), snapshot.map_integrations);
+  }
   pipeline.run(dataset_source(info, odometry, config.scan.camera, std::move(source_options)));
   if (!pipeline.error().empty()) throw std::runtime_error(pipeline.error());
   writer.write_all(run, pipeline.slam().map(), info);
+  if (run.localizing) {
+    const auto first = std::find_if(run.frames.begin(), run.frames.end(), [](const FrameRecord &f) { return f.localized; });
+    if (first == run.frames.end()) {
+      std::printf("not localized on %s: no pose confirmed in %zu frames (trajectory.tum has none)\n",
+                  options.map_file.c_str(), run.frames.size());
+    } else {
+      std::printf("localized on %s at frame %td (%td frames before it have no pose)\n", options.map_file.c_str(),
+                  first - run.frames.begin() + 1, first - run.frames.begin());
+    }
+  }
   const grid::GridImage grid_image = occupancy.image();
   if (grid_image.width > 0)
     io::write_nav2_map(std::filesystem::path(options.out_dir) / "map.yaml", grid_image);
@@ -128,6 +148,13 @@ void add_replay_command(CLI::App &app) {
       ->capture_default_str();
   auto *degrade_seed = command->add_option("--degrade-seed", options->degrade_seed,
                                            "seed of the image degradation (default: the config's, 1)");
+  auto *map = command->add_option("--map", options->map_file, "a saved map (snapshot) to localize on");
+  command
+      ->add_flag("--localize", options->localize,
+                 "start on --map from an unknown pose: search the map, confirm over several frames, then track "
+                 "without changing the map; frames before the pose is confirmed are left out of trajectory.tum")
+      ->needs(map);
+  map->needs(command->get_option("--localize"));
   command->callback([options, degrade_seed] {
     run_replay(*options, degrade_seed->count() > 0 ? std::optional(options->degrade_seed) : std::nullopt);
   });

@@ -133,6 +133,21 @@ std::vector<io::MapPointRecord> map_records(const slam::PointMap &map) {
   return records;
 }
 
+// The frames that have a pose, with their ground truth and odometry.
+RunRecord with_pose(const RunRecord &run) {
+  RunRecord posed = run;
+  posed.frames.clear();
+  posed.ground_truth.clear();
+  posed.odometry_map.clear();
+  for (std::size_t i = 0; i < run.frames.size(); ++i) {
+    if (!run.frames[i].localized) continue;
+    posed.frames.push_back(run.frames[i]);
+    if (i < run.ground_truth.size()) posed.ground_truth.push_back(run.ground_truth[i]);
+    if (i < run.odometry_map.size()) posed.odometry_map.push_back(run.odometry_map[i]);
+  }
+  return posed;
+}
+
 }  // namespace
 
 OutputWriter::OutputWriter(std::filesystem::path dir) : dir_(std::move(dir)) {
@@ -152,8 +167,11 @@ void OutputWriter::write_thesis_map(int frame, const std::vector<slam::MapPoint>
   io::write_text_file(dir_ / ("mapa" + std::to_string(frame) + ".txt"), out.str());
 }
 
-void OutputWriter::write_all(const RunRecord &run, const slam::PointMap &map,
+void OutputWriter::write_all(const RunRecord &all, const slam::PointMap &map,
                              const io::DatasetInfo &info) const {
+  // Frames still searching for their pose on a saved map have none: the pose files, the
+  // covariance and the errors are of the frames that have one (all of them, unless localizing).
+  const RunRecord run = with_pose(all);
   std::vector<io::StampedPose> trajectory;
   std::vector<Eigen::Isometry2d> estimate;
   for (const FrameRecord &f : run.frames) {
@@ -164,26 +182,27 @@ void OutputWriter::write_all(const RunRecord &run, const slam::PointMap &map,
   const auto records = map_records(map);
   io::write_map_csv(dir_ / "map.csv", records);
   io::write_map_ply(dir_ / "map.ply", records);
-  io::write_text_file(dir_ / "profile.csv", profile_csv(run, false));
+  io::write_text_file(dir_ / "profile.csv", profile_csv(all, false));
   io::write_covariance_csv(dir_ / "covariance.csv", covariance_records(run));
-  io::write_text_file(dir_ / "timelog.txt", profile_csv(run, true));
+  io::write_text_file(dir_ / "timelog.txt", profile_csv(all, true));
   io::write_text_file(dir_ / "autolocalizacao.txt", thesis_localisation(run));
   io::write_text_file(dir_ / "vetores.txt", thesis_vectors(run));
   io::write_text_file(dir_ / "odometriaxy.txt", thesis_odometry(run));
 
   nlohmann::json summary;
   summary["dataset"] = info.name;
-  summary["frames"] = run.frames.size();
+  summary["frames"] = all.frames.size();
   const auto integrated =
-      std::count_if(run.frames.begin(), run.frames.end(), [](auto &f) { return f.integrated; });
+      std::count_if(all.frames.begin(), all.frames.end(), [](auto &f) { return f.integrated; });
   summary["integrated"] = integrated;
-  summary["not_integrated"] = static_cast<long>(run.frames.size()) - integrated;
-  summary["skipped"] = std::count_if(run.frames.begin(), run.frames.end(), [](auto &f) { return f.skipped; });
+  summary["not_integrated"] = static_cast<long>(all.frames.size()) - integrated;
+  summary["skipped"] = std::count_if(all.frames.begin(), all.frames.end(), [](auto &f) { return f.skipped; });
+  if (all.localizing) summary["not_localized"] = all.frames.size() - run.frames.size();
   summary["map_points"] = map.points().size();
   summary["stage_ms"] = stage_statistics(run.frames);
   std::vector<double> latency_ms;
   long dropped = 0;
-  for (const FrameRecord &f : run.frames) {
+  for (const FrameRecord &f : all.frames) {
     latency_ms.push_back(f.latency_ms);
     dropped += f.dropped_before;
   }

@@ -24,6 +24,7 @@ struct FrameRecord {
   Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
   bool skipped = false;  ///< the image could not be used
   bool integrated = false;
+  bool localized = true;  ///< false: still searching for its pose on a saved map (no pose)
   slam::Attempt attempt = slam::Attempt::kNone;
   double srel_percent = 0.0;
   int iterations = 0;
@@ -41,6 +42,7 @@ struct RunRecord {
   std::vector<Eigen::Isometry2d> odometry_map;  ///< odometry in the map frame (first pose = identity)
   std::string degradation_factors = "none";     ///< image degradation applied on the fly (replay --degrade)
   std::uint64_t degradation_seed = 0;
+  bool localizing = false;  ///< started on a saved map from an unknown pose (replay --localize)
 };
 
 }  // namespace omnislam::app

@@ -61,6 +61,18 @@ void Pipeline::resume(std::vector<slam::MapPoint> points, int integrations,
   slam_.resume(std::move(points), integrations, T_map_base, covariance, T_odom_base);
 }
 
+void Pipeline::relocalize(std::vector<slam::MapPoint> points, int integrations,
+                          const slam::RelocalizerConfig &config, std::optional<slam::SearchWindow> window) {
+  if (started_) throw std::logic_error("Pipeline::relocalize after start");
+  slam::Points2 positions;
+  positions.reserve(points.size());
+  for (const slam::MapPoint &p : points) positions.push_back(p.position_m);
+  relocalizer_ = std::make_unique<slam::Relocalizer>(positions, config);
+  saved_points_ = std::move(points);
+  saved_integrations_ = integrations;
+  window_ = window;
+}
+
 void Pipeline::start(FrameSource source) {
   if (started_) throw std::logic_error("Pipeline::start called twice");
   started_ = true;
@@ -222,6 +234,21 @@ void Pipeline::stereo_loop() {
   queues_[kSlamQueue].close();
 }
 
+void Pipeline::relocalize_frame(Frame &frame, const std::optional<Eigen::Isometry2d> &T_odom_base) {
+  // The window travels with the robot: its centre follows the odometry since the last frame.
+  if (window_ && T_odom_base && window_odometry_) {
+    window_->T_map_base = window_->T_map_base * (window_odometry_->inverse() * *T_odom_base);
+  }
+  if (T_odom_base) window_odometry_ = T_odom_base;
+  const slam::LocalizationResult found = relocalizer_->process(scan_points(frame.scan), T_odom_base, window_);
+  frame.localized = found.state == slam::LocalizationState::kLocalized;
+  if (!frame.localized) return;
+  frame.estimate.T_map_base = found.T_map_base;
+  frame.estimate.covariance = found.covariance;
+  slam_.resume(std::move(saved_points_), saved_integrations_, found.T_map_base, found.covariance, T_odom_base);
+  relocalizer_.reset();
+}
+
 void Pipeline::slam_loop() {
   Clock::time_point last_map = Clock::time_point::min();
   Clock::time_point last_state = Clock::now();
@@ -230,8 +257,12 @@ void Pipeline::slam_loop() {
     busy(3, true);
     stall_if_asked(3, *frame);
     StepClock clock(*frame);
-    frame->estimate = slam_.process(scan_points(frame->scan),
-                                    frame->has_odometry ? std::optional(frame->T_odom_base) : std::nullopt);
+    const auto odometry = frame->has_odometry ? std::optional(frame->T_odom_base) : std::nullopt;
+    if (relocalizer_) {
+      relocalize_frame(*frame, odometry);
+    } else {
+      frame->estimate = slam_.process(scan_points(frame->scan), odometry);
+    }
     clock.lap(kSlam);
     const Clock::time_point now = Clock::now();
     if (frame->estimate.integrated) {

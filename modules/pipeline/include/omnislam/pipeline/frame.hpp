@@ -58,6 +58,9 @@ struct Frame {
   stereo::LobeWork outer;
   stereo::LocalScan scan;        ///< base_link, metres
   slam::FrameEstimate estimate;  ///< pose in the map frame
+  /// false while the pipeline still searches for its pose on a saved map (Pipeline::relocalize):
+  /// the frame has no pose.
+  bool localized = true;
   /// The map after this frame, when the pipeline was asked for snapshots and it changed,
   /// or when state_due.
   std::shared_ptr<const std::vector<slam::MapPoint>> map;

@@ -4,6 +4,7 @@
 #include <atomic>
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <optional>
 #include <string>
 #include <thread>
@@ -11,6 +12,7 @@
 #include "omnislam/pipeline/frame.hpp"
 #include "omnislam/pipeline/profiler.hpp"
 #include "omnislam/pipeline/spsc_queue.hpp"
+#include "omnislam/slam/relocalizer.hpp"
 #include "omnislam/slam/slam.hpp"
 #include "omnislam/stereo/stereo_config.hpp"
 
@@ -69,6 +71,13 @@ class Pipeline {
   void resume(std::vector<slam::MapPoint> points, int integrations, const Eigen::Isometry2d &T_map_base,
               const Eigen::Matrix3d &covariance, const std::optional<Eigen::Isometry2d> &T_odom_base);
 
+  /// Starts on a saved map from an unknown pose (slam::Relocalizer): frames are searched
+  /// for their pose on the map, and leave the SLAM stage with Frame::localized false until
+  /// one pose is confirmed; from then on the SLAM continues from it on the saved map
+  /// (slam::Slam::resume). Only before start().
+  void relocalize(std::vector<slam::MapPoint> points, int integrations, const slam::RelocalizerConfig &config = {},
+                  std::optional<slam::SearchWindow> window = {});
+
   /// Starts the five threads. Call once.
   void start(FrameSource source);
   /// Asks capture to stop after the current frame; every captured frame still drains
@@ -105,6 +114,9 @@ class Pipeline {
   void frontend_loop();
   void stereo_loop();
   void slam_loop();
+  /// One frame through the relocaliser; on the frame that confirms a pose, hands the saved
+  /// map and that pose to slam_.
+  void relocalize_frame(Frame &frame, const std::optional<Eigen::Isometry2d> &T_odom_base);
   void publish_loop();
   [[nodiscard]] bool take(Queue &queue, std::size_t index, FramePtr &frame);
   void forward(Queue &queue, FramePtr &frame);
@@ -117,6 +129,12 @@ class Pipeline {
   PipelineConfig config_;
   Sinks sinks_;
   slam::Slam slam_;
+  /// While relocalising: the search, the saved map it hands to slam_, and the search window.
+  std::unique_ptr<slam::Relocalizer> relocalizer_;
+  std::vector<slam::MapPoint> saved_points_;
+  int saved_integrations_ = 0;
+  std::optional<slam::SearchWindow> window_;
+  std::optional<Eigen::Isometry2d> window_odometry_;  ///< odometry of the last relocalised frame
   std::array<Queue, 4> queues_;
   std::atomic<bool> stop_{false};   ///< capture stops reading
   std::atomic<bool> abort_{false};  ///< a sink failed: stop at once, discard what is queued

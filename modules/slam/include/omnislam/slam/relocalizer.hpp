@@ -1,0 +1,88 @@
+#pragma once
+
+#include <Eigen/Geometry>
+#include <optional>
+#include <vector>
+
+#include "omnislam/slam/correlative_matcher.hpp"
+#include "omnislam/slam/nearest_neighbors.hpp"
+#include "omnislam/slam/trimmed_icp.hpp"
+
+/// @file
+/// Global relocalisation on a saved map: the robot's pose found from its scans alone (no
+/// start pose, or a rough one as a search window), and confirmed over several frames before
+/// it is reported. Every frame, the whole map (or the window) is searched by correlative
+/// matching; each pose that explains the scan nearly as well as the best one is a
+/// hypothesis, refined by Trimmed ICP and carried to the next frame by odometry. A pose is
+/// reported only when one hypothesis alone has survived confirm_frames frames: in a
+/// symmetric room two hypotheses survive forever, and the robot is never localized on the
+/// wrong one of them. Not thread-safe: one instance, fed frames in order.
+
+namespace omnislam::slam {
+
+struct RelocalizerConfig {
+  CorrelativeMatcherConfig matcher;
+  TrimmedIcpConfig icp;
+  /// A pose is a hypothesis when its mean point score reaches min_score (the scan mostly on
+  /// the map's structure) and relative_score of the frame's best: a wrong pose that a
+  /// repeated structure makes nearly as good stays in the running instead of being beaten
+  /// by noise.
+  double min_score = 0.5;
+  double relative_score = 0.8;
+  /// Poses closer than this are the same hypothesis.
+  double distinct_m = 0.5;
+  double distinct_rad = 0.35;
+  /// A refinement is accepted as in the SLAM: it fits and overlaps.
+  double max_rms_m = 0.04;
+  double min_inlier_share = 0.7;
+  /// Frames the sole surviving hypothesis must have been tracked for.
+  int confirm_frames = 3;
+  int min_scan_points = 20;
+};
+
+enum class LocalizationState { kSearching, kLocalized };
+
+struct LocalizationResult {
+  LocalizationState state = LocalizationState::kSearching;
+  Eigen::Isometry2d T_map_base = Eigen::Isometry2d::Identity();  ///< when localized
+  Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();          ///< of the last refinement (x, y, yaw)
+  int hypotheses = 0;        ///< alive after this frame
+  double best_score = 0.0;   ///< of the frame's best hypothesis
+  int searched_poses = 0;    ///< candidates the correlative search returned
+};
+
+class Relocalizer {
+ public:
+  explicit Relocalizer(const Points2 &map_points, RelocalizerConfig config = {});
+
+  /// One frame: its scan (base_link, metres) and odometry pose (empty: none; the robot is
+  /// then taken to stand still since the last frame, and hypotheses rely on the search).
+  /// With a window, only poses inside it are searched (a rough pose with its uncertainty).
+  [[nodiscard]] LocalizationResult process(const Points2 &scan_base,
+                                           const std::optional<Eigen::Isometry2d> &T_odom_base,
+                                           const std::optional<SearchWindow> &window = {});
+
+  /// Forgets every hypothesis (a new search from the next frame).
+  void reset();
+
+ private:
+  struct Hypothesis {
+    Eigen::Isometry2d T_map_base = Eigen::Isometry2d::Identity();
+    Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
+    double score = 0.0;
+    int frames = 0;  ///< consecutive frames it was confirmed in
+  };
+  /// ICP from `guess` against the map; nullopt when the fit is rejected.
+  [[nodiscard]] std::optional<TrimmedIcpResult> refine(const Points2 &scan_base,
+                                                        const Eigen::Isometry2d &guess) const;
+  [[nodiscard]] bool same_pose(const Eigen::Isometry2d &a, const Eigen::Isometry2d &b) const;
+
+  RelocalizerConfig config_;
+  CorrelativeMatcher matcher_;
+  NearestNeighbors map_index_;
+  std::vector<Hypothesis> hypotheses_;
+  std::optional<Eigen::Isometry2d> last_T_odom_base_;
+  std::optional<Hypothesis> localized_;
+};
+
+}  // namespace omnislam::slam

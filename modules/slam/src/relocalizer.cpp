@@ -1,0 +1,119 @@
+#include "omnislam/slam/relocalizer.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+#include "omnislam/slam/planar_pose.hpp"
+
+namespace omnislam::slam {
+
+Relocalizer::Relocalizer(const Points2 &map_points, RelocalizerConfig config)
+    : config_(config), matcher_(map_points, config.matcher), map_index_(map_points) {}
+
+void Relocalizer::reset() {
+  hypotheses_.clear();
+  last_T_odom_base_.reset();
+  localized_.reset();
+}
+
+bool Relocalizer::same_pose(const Eigen::Isometry2d &a, const Eigen::Isometry2d &b) const {
+  return (a.translation() - b.translation()).norm() <= config_.distinct_m &&
+         std::abs(std::remainder(yaw_rad_of(a) - yaw_rad_of(b), 2.0 * std::numbers::pi)) <= config_.distinct_rad;
+}
+
+std::optional<TrimmedIcpResult> Relocalizer::refine(const Points2 &scan_base,
+                                                     const Eigen::Isometry2d &guess) const {
+  const TrimmedIcpResult fit = register_trimmed_icp(map_index_, scan_base, guess, config_.icp);
+  if (!fit.valid || std::sqrt(fit.final_error_m2) > config_.max_rms_m ||
+      fit.inlier_share < config_.min_inlier_share)
+    return std::nullopt;
+  return fit;
+}
+
+LocalizationResult Relocalizer::process(const Points2 &scan_base,
+                                        const std::optional<Eigen::Isometry2d> &T_odom_base,
+                                        const std::optional<SearchWindow> &window) {
+  // 1. Carry every hypothesis by the odometry motion since the last frame.
+  Eigen::Isometry2d motion = Eigen::Isometry2d::Identity();
+  if (T_odom_base && last_T_odom_base_) motion = last_T_odom_base_->inverse() * *T_odom_base;
+  if (T_odom_base) last_T_odom_base_ = T_odom_base;
+  for (Hypothesis &hypothesis : hypotheses_) hypothesis.T_map_base = hypothesis.T_map_base * motion;
+
+  LocalizationResult result;
+  if (localized_) {
+    // Tracking: refined where the scan fits, else carried by odometry.
+    localized_->T_map_base = localized_->T_map_base * motion;
+    if (static_cast<int>(scan_base.size()) >= config_.min_scan_points) {
+      if (const auto refined = refine(scan_base, localized_->T_map_base)) {
+        localized_->T_map_base = refined->T_model_sample;
+        localized_->covariance = refined->covariance;
+      }
+    }
+    result.state = LocalizationState::kLocalized;
+    result.T_map_base = localized_->T_map_base;
+    result.covariance = localized_->covariance;
+    result.hypotheses = 1;
+    result.best_score = matcher_.score(scan_base, localized_->T_map_base);
+    return result;
+  }
+  if (static_cast<int>(scan_base.size()) < config_.min_scan_points) {
+    result.hypotheses = static_cast<int>(hypotheses_.size());
+    return result;
+  }
+
+  // 2. Search the map (or the window) for every pose that explains the scan nearly as well
+  //    as the best.
+  const std::vector<PoseCandidate> candidates = matcher_.search(
+      scan_base, config_.min_score, config_.relative_score, config_.distinct_m, config_.distinct_rad, window);
+  result.searched_poses = static_cast<int>(candidates.size());
+  double best = 0.0;
+  for (const PoseCandidate &candidate : candidates) best = std::max(best, candidate.score);
+
+  // 3. A tracked hypothesis survives where its refined pose still explains the scan.
+  std::vector<Hypothesis> alive;
+  const auto admissible = [&](double score) {
+    return score >= config_.min_score && score >= config_.relative_score * best;
+  };
+  for (Hypothesis hypothesis : hypotheses_) {
+    const auto refined = refine(scan_base, hypothesis.T_map_base);
+    if (!refined) continue;
+    hypothesis.T_map_base = refined->T_model_sample;
+    hypothesis.covariance = refined->covariance;
+    hypothesis.score = matcher_.score(scan_base, hypothesis.T_map_base);
+    if (!admissible(hypothesis.score)) continue;
+    ++hypothesis.frames;
+    best = std::max(best, hypothesis.score);
+    alive.push_back(hypothesis);
+  }
+  // 4. Every other candidate is a new hypothesis.
+  for (const PoseCandidate &candidate : candidates) {
+    const auto known = [&](const Eigen::Isometry2d &pose) {
+      return std::any_of(alive.begin(), alive.end(),
+                         [&](const Hypothesis &h) { return same_pose(h.T_map_base, pose); });
+    };
+    if (known(candidate.T_map_base)) continue;
+    const auto refined = refine(scan_base, candidate.T_map_base);
+    if (!refined || known(refined->T_model_sample)) continue;
+    const double score = matcher_.score(scan_base, refined->T_model_sample);
+    if (!admissible(score)) continue;
+    best = std::max(best, score);
+    alive.push_back({refined->T_model_sample, refined->covariance, score, 1});
+  }
+  hypotheses_.clear();
+  for (const Hypothesis &hypothesis : alive)
+    if (admissible(hypothesis.score)) hypotheses_.push_back(hypothesis);
+
+  // 5. Localized when one hypothesis alone has held for confirm_frames frames.
+  result.hypotheses = static_cast<int>(hypotheses_.size());
+  result.best_score = best;
+  if (hypotheses_.size() == 1 && hypotheses_.front().frames >= config_.confirm_frames) {
+    localized_ = hypotheses_.front();
+    result.state = LocalizationState::kLocalized;
+    result.T_map_base = localized_->T_map_base;
+    result.covariance = localized_->covariance;
+  }
+  return result;
+}
+
+}  // namespace omnislam::slam

@@ -1,0 +1,41 @@
+#pragma once
+
+#include <Eigen/Geometry>
+#include <filesystem>
+#include <vector>
+
+#include "omnislam/slam/nearest_neighbors.hpp"
+
+/// @file
+/// Relocalisation on the saved map of a bundled dataset (tests and benchmarks only): the
+/// map a replay builds (SLAM over every frame, the first frame's pose defines the map
+/// frame), then a fresh relocaliser started at every frame in turn with no pose.
+
+namespace omnislam::test {
+
+struct LocalizationRun {
+  std::vector<slam::Points2> scans;          ///< base_link, per frame
+  std::vector<Eigen::Isometry2d> odometry;   ///< the dataset's noisy odometry
+  std::vector<Eigen::Isometry2d> truth;      ///< map frame = the first frame's pose
+  slam::Points2 map;                         ///< the map after the whole run
+};
+
+/// Front-end and SLAM over every frame of the dataset in `dir` (throws naming a missing file).
+[[nodiscard]] LocalizationRun build_localization_run(const std::filesystem::path &dir);
+
+struct RelocalizationOutcome {
+  int starts = 0;
+  int localized = 0;
+  int correct = 0;  ///< localized within 50 mm and 1 deg of the truth
+  int wrong = 0;    ///< localized anywhere else
+  int frames_needed = 0;  ///< summed over the localized starts (the confirming frame included)
+  double worst_error_m = 0.0;    ///< of the correct ones
+  double worst_error_deg = 0.0;
+  std::vector<double> frame_ms;  ///< time of every relocaliser frame before localization
+};
+
+/// Starts a fresh relocaliser at every frame that has `max_frames` frames after it, and feeds
+/// it those frames until it reports a pose.
+[[nodiscard]] RelocalizationOutcome relocalize_from_every_frame(const LocalizationRun &run, int max_frames);
+
+}  // namespace omnislam::test
