@@ -110,6 +110,8 @@ TEST_CASE(
   CHECK_THROWS_WITH(
       load_config(write_file("policy.yaml", "persistence:\n  on_corrupt_snapshot: ignore\n")),
       Catch::EndsWith("policy.yaml:2:24: 'persistence.on_corrupt_snapshot' must be start_fresh or refuse"));
+  CHECK_THROWS_WITH(load_config(write_file("start.yaml", "persistence: {start_pose: guess}\n")),
+                    Catch::EndsWith("'persistence.start_pose' must be auto, saved or search"));
   CHECK_THROWS_AS(load_config("/nonexistent/omnislam.yaml"), ConfigError);
 }
 
@@ -121,6 +123,7 @@ TEST_CASE("config: persistence and localization keys", "[io][config]") {
                                "  resume: false\n"
                                "  snapshot_period_s: 5\n"
                                "  on_corrupt_snapshot: refuse\n"
+                               "  start_pose: search\n"
                                "service: {stage_timeout_s: 2.5}\n");
   const omnislam::io::Config config = omnislam::io::load_config(file);
   CHECK(config.slam.localization_only);
@@ -129,7 +132,9 @@ TEST_CASE("config: persistence and localization keys", "[io][config]") {
   CHECK(config.service.stage_timeout_s == 2.5);
   CHECK(config.persistence.snapshot_period_s == 5.0);
   CHECK(config.persistence.refuse_corrupt_snapshot);
+  CHECK(config.persistence.start_pose == omnislam::io::PersistenceConfig::StartPose::kSearch);
   const omnislam::io::Config defaults;
+  CHECK(defaults.persistence.start_pose == omnislam::io::PersistenceConfig::StartPose::kAuto);
   CHECK_FALSE(defaults.slam.localization_only);
   CHECK(defaults.persistence.snapshot_period_s == 30.0);
   CHECK_FALSE(defaults.persistence.refuse_corrupt_snapshot);

@@ -274,3 +274,53 @@ dds: {{enabled: false}}
     assert f"{off:.2f} px from the configured (511.50, 511.50)" in check[0]
     assert ("[warning]" in check[0]) == (off > 0.5), check[0]
     assert ("omnislam calibrate rim" in check[0]) == (off > 0.5)
+
+
+def test_localization_only_finds_its_pose_on_the_saved_map(tmp_path):
+    """With slam.localization_only the saved pose is not trusted (persistence.start_pose auto):
+    the service searches the saved map, publishes nothing until one pose is confirmed, then
+    tracks in the saved map's frame without changing the map."""
+    state = tmp_path / "state"
+    state.mkdir()
+    mapping = tmp_path / "mapping"
+    subprocess.run([os.environ["OMNISLAM_BIN"], "replay", str(DATASET), "--out", str(mapping)], check=True,
+                   capture_output=True)
+    subprocess.run([os.environ["OMNISLAM_BIN"], "map", "save", str(mapping), str(state / "state.omnisnap")],
+                   check=True, capture_output=True)
+    out = tmp_path / "out"
+    service = start(write_config(tmp_path / "c.yaml", state=state, out=out, rate_hz=0,
+                                 extra="slam: {localization_only: true}\n"))
+    log, _ = service.communicate(timeout=120)
+    assert service.returncode == 0, log
+    assert "searching for the pose on the saved map" in log
+    assert "localized on the saved map at frame 3 after 2 frames" in log
+    poses = [line for line in (out / "trajectory.tum").read_text().splitlines() if not line.startswith("#")]
+    assert len(poses) == 35
+    assert evaluate(out)["ate"]["max_m"] <= 0.02
+    assert (out / "map.csv").read_text() == (mapping / "map.csv").read_text()
+
+
+def test_start_pose_search_on_another_rooms_map_publishes_nothing(tmp_path):
+    state = tmp_path / "state"
+    state.mkdir()
+    mapping = tmp_path / "mapping"
+    office = REPO / "datasets" / "office-real"
+    subprocess.run([os.environ["OMNISLAM_BIN"], "replay", str(office), "--out", str(mapping)], check=True,
+                   capture_output=True)
+    subprocess.run([os.environ["OMNISLAM_BIN"], "map", "save", str(mapping), str(state / "state.omnisnap")],
+                   check=True, capture_output=True)
+    before = (state / "state.omnisnap").read_bytes()
+    out = tmp_path / "out"
+    config = tmp_path / "search.yaml"
+    config.write_text(f"""
+input: {{source: dataset, path: {DATASET}, rate_hz: 0}}
+pipeline: {{mode: replay}}
+dds: {{enabled: false}}
+persistence: {{state_dir: {state}, snapshot_period_s: 0.5, start_pose: search}}
+service: {{output_dir: {out}}}
+""")
+    service = start(config)
+    log, _ = service.communicate(timeout=120)
+    assert service.returncode == 0, log
+    assert "37 frames and no pose found on the saved map (it is kept unchanged)" in log
+    assert (state / "state.omnisnap").read_bytes() == before

@@ -11,6 +11,7 @@
 #include <exception>
 #include <filesystem>
 #include <limits>
+#include <numbers>
 #include <memory>
 #include <optional>
 #include <utility>
@@ -22,6 +23,7 @@
 #include "omnislam/io/config.hpp"
 #include "omnislam/io/grid_files.hpp"
 #include "omnislam/pipeline/pipeline.hpp"
+#include "omnislam/slam/planar_pose.hpp"
 #include "rig_check.hpp"
 #include "run_outputs.hpp"
 #include "scan_rays.hpp"
@@ -106,6 +108,11 @@ int run_service(const std::string &config_file) {
   if (snapshot_file.empty())
     spdlog::warn("no persistence.state_dir and no STATE_DIRECTORY: the map is not saved");
   const std::optional<io::Snapshot> resumed = resume_state(config, snapshot_file, config_hash);
+  // Resumed with the pose unknown (a robot carried while off): found on the saved map first.
+  const io::PersistenceConfig::StartPose start_pose = config.persistence.start_pose;
+  const bool search_start = resumed && (start_pose == io::PersistenceConfig::StartPose::kSearch ||
+                                        (start_pose == io::PersistenceConfig::StartPose::kAuto &&
+                                         config.slam.localization_only));
 
   sigset_t signals;
   sigemptyset(&signals);
@@ -130,8 +137,10 @@ int run_service(const std::string &config_file) {
   dds::StatusMessage status{system_time_s(), dds::ServiceState::kStarting, 0, 0, 0, ""};
   if (publisher) publisher->status(status);
 
-  const ServiceInput input =
-      make_service_input(config, odometry, resumed ? resumed->t_s : -std::numeric_limits<double>::infinity());
+  // A dataset input continues after the snapshot's frame when the saved pose is taken as is;
+  // a robot whose pose is searched for may be anywhere in it.
+  const ServiceInput input = make_service_input(
+      config, odometry, resumed && !search_start ? resumed->t_s : -std::numeric_limits<double>::infinity());
   spdlog::info("input: {}, {} Hz, mode {}, DDS domain {}", input.description, input.rate_hz,
                service.pipeline.mode, service.dds.enabled ? std::to_string(service.dds.domain_id) : "off");
   if (publisher && service.dds.wait_for_subscribers > 0 &&
@@ -150,6 +159,8 @@ int run_service(const std::string &config_file) {
   const bool expects_odometry = service.input.odometry != "none";
 
   RunRecord run;
+  bool posed = !search_start;  // a frame has had a pose (set by the publish thread; read after join)
+  std::uint64_t not_localized = 0;
   grid::OccupancyGrid occupancy;          // rt/map, and map.yaml + map.pgm in output_dir
   std::optional<FrameRecord> last_frame;  // for the final snapshot
   pipeline::Sinks sinks;
@@ -178,6 +189,19 @@ int run_service(const std::string &config_file) {
     }
     if (frame.dropped_before > 0)
       spdlog::debug("{} frames dropped before frame {}", frame.dropped_before, frame.sequence);
+    if (!frame.localized) {  // no pose yet: nothing to publish, grid or save
+      ++not_localized;
+      return;
+    }
+    if (!posed) {
+      posed = true;
+      spdlog::info("localized on the saved map at frame {} after {} frames: x {:.3f} m, y {:.3f} m, yaw {:.1f} deg",
+                   frame.sequence, not_localized, frame.estimate.T_map_base.translation().x(),
+                   frame.estimate.T_map_base.translation().y(),
+                   slam::yaw_rad_of(frame.estimate.T_map_base) * 180.0 / std::numbers::pi);
+      if (publisher)
+        publisher->status({system_time_s(), dds::ServiceState::kRunning, frame.sequence, 0, 0, ""});
+    }
     const bool gridded = publisher || !service.output_dir.empty();
     if (gridded && !frame.skipped())
       occupancy.add_scan(frame.estimate.T_map_base, scan_rays(frame.scan, config.scan.camera));
@@ -209,14 +233,24 @@ int run_service(const std::string &config_file) {
   pipeline::Pipeline pipeline(config.scan, config.slam,
                               pipeline_config(config, input.rate_hz, snapshots.has_value()),
                               std::move(sinks));
-  if (resumed) {
+  if (search_start) {
+    spdlog::info("searching for the pose on the saved map ({} points; persistence.start_pose {}): nothing is "
+                 "published until one pose is confirmed",
+                 resumed->points.size(), config.slam.localization_only ? "auto, localization_only" : "search");
+    pipeline.relocalize(resumed->points, resumed->map_integrations);
+    status.state = dds::ServiceState::kLocalizing;  // running becomes the publish thread's to say
+    status.stamp_s = system_time_s();
+    if (publisher) publisher->status(status);
+  } else if (resumed) {
     pipeline.resume(resumed->points, resumed->map_integrations, resumed->T_map_base, resumed->covariance,
                     resumed->T_odom_base);
   }
   pipeline.start(checked_source(input.source, config.scan.camera, status));
-  status.state = dds::ServiceState::kRunning;
-  status.stamp_s = system_time_s();
-  if (publisher) publisher->status(status);
+  if (!search_start) {
+    status.state = dds::ServiceState::kRunning;
+    status.stamp_s = system_time_s();
+    if (publisher) publisher->status(status);
+  }
   const SystemdNotifier notifier;
   // systemd's STATUS line carries the rig check's warning too (systemctl status shows it).
   notifier.ready("running: " + input.description +
@@ -251,7 +285,7 @@ int run_service(const std::string &config_file) {
   }
   const grid::GridImage final_grid = occupancy.image();  // empty when nothing was gridded
   if (publisher) {
-    publisher->map(last_stamp, pipeline.slam().map().points());  // the final state
+    if (posed) publisher->map(last_stamp, pipeline.slam().map().points());  // the final state
     if (final_grid.width > 0) publisher->grid(last_stamp, final_grid);
     publisher->status(status);
     publisher->flush(2.0);
@@ -271,6 +305,9 @@ int run_service(const std::string &config_file) {
   spdlog::info("stopped: {} frames in, {} out, {} dropped, {} skipped, {} without odometry", status.frames_in,
                status.frames_out, status.frames_dropped, counts.skipped.load(),
                counts.without_odometry.load());
+  if (search_start && posed) spdlog::info("{} frames before the pose was found on the saved map", not_localized);
+  if (search_start && !posed)
+    spdlog::warn("{} frames and no pose found on the saved map (it is kept unchanged)", not_localized);
   if (!pipeline.error().empty()) {
     spdlog::error("{}", pipeline.error());
     return 1;

@@ -210,6 +210,11 @@ Config load_config(const std::filesystem::path &file) {
     if (config.persistence.snapshot_period_s < 0.0) persistence.fail("snapshot_period_s", "must be >= 0");
     read_choice(persistence, "on_corrupt_snapshot", config.persistence.refuse_corrupt_snapshot,
                 {{"start_fresh", false}, {"refuse", true}}, "must be start_fresh or refuse");
+    read_choice(persistence, "start_pose", config.persistence.start_pose,
+                {{"auto", PersistenceConfig::StartPose::kAuto},
+                 {"saved", PersistenceConfig::StartPose::kSaved},
+                 {"search", PersistenceConfig::StartPose::kSearch}},
+                "must be auto, saved or search");
   });
   read_section(top, "degradation",
                [&](YamlSection &degradation) { detail::read_degradation(degradation, config.degradation); });

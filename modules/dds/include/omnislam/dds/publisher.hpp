@@ -22,7 +22,8 @@ enum class ServiceState : std::uint8_t {
   kRunning = 1,
   kStopping = 2,
   kStopped = 3,
-  kFailed = 4
+  kFailed = 4,
+  kLocalizing = 5  ///< searching for its pose on the saved map: nothing is published until found
 };
 
 struct StatusMessage {

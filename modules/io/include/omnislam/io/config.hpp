@@ -38,7 +38,8 @@
 ///                      inner_radius_px, outer_radius_px},
 ///               blur: {enabled, radius_px}, noise: {enabled, full_well_e, read_noise_dn},
 ///               jpeg: {enabled, quality}}
-/// persistence: {state_dir, resume, snapshot_period_s, on_corrupt_snapshot: start_fresh | refuse}
+/// persistence: {state_dir, resume, snapshot_period_s, on_corrupt_snapshot: start_fresh | refuse,
+///               start_pose: auto | saved | search}
 /// input, pipeline, dds, service: omnislamd's sections (service_config.hpp)
 /// ```
 /// The field meanings are documented on the structs (vision_config.hpp, stereo_config.hpp, slam.hpp,
@@ -62,6 +63,11 @@ struct PersistenceConfig {
   bool resume = true;                    ///< continue from the snapshot at start (false: a new map)
   double snapshot_period_s = 30.0;       ///< how often the map and pose are saved; 0 = only at shutdown
   bool refuse_corrupt_snapshot = false;  ///< false: a corrupt snapshot is moved aside and a new map started
+  /// Where the robot is when it resumes: the snapshot's pose (kSaved), or unknown and
+  /// searched for on the saved map before anything is published (kSearch: a robot carried
+  /// while off). kAuto: kSearch with slam.localization_only, else kSaved.
+  enum class StartPose { kAuto, kSaved, kSearch };
+  StartPose start_pose = StartPose::kAuto;
 };
 
 struct Config {
