@@ -21,26 +21,7 @@ namespace {
 using omnislam::slam::MapPoint;
 using omnislam::test::Segment;
 
-constexpr double kRoomM = 5.0;
-constexpr double kDoorM = 1.0;
 constexpr double kPointSpacingM = 0.02;
-
-// A grid of rooms: every wall has a door in its middle.
-std::vector<Segment> building(int rooms_per_side) {
-  std::vector<Segment> walls;
-  for (int i = 0; i <= rooms_per_side; ++i) {
-    const double at = i * kRoomM;
-    for (int j = 0; j < rooms_per_side; ++j) {
-      const double from = j * kRoomM, door_from = from + (kRoomM - kDoorM) / 2, door_to = door_from + kDoorM;
-      const bool outer = i == 0 || i == rooms_per_side;
-      walls.push_back({{at, from}, {at, outer ? from + kRoomM : door_from}});
-      if (!outer) walls.push_back({{at, door_to}, {at, from + kRoomM}});
-      walls.push_back({{from, at}, {outer ? from + kRoomM : door_from, at}});
-      if (!outer) walls.push_back({{door_to, at}, {from + kRoomM, at}});
-    }
-  }
-  return walls;
-}
 
 std::vector<MapPoint> sample(const std::vector<Segment> &walls) {
   std::vector<MapPoint> points;
@@ -68,7 +49,7 @@ int main(int argc, char **argv) {
       frames);
   std::printf("  %-10s %-8s %8s %8s %8s\n", "map points", "rooms", "median", "p99", "max");
   for (const int side : {3, 6, 10, 15}) {
-    const std::vector<Segment> walls = building(side);
+    const std::vector<Segment> walls = omnislam::test::building(side);
     std::vector<MapPoint> points = sample(walls);
     const std::size_t size = points.size();
     omnislam::slam::Slam slam;

@@ -46,6 +46,24 @@ inline std::vector<Segment> square_room() {
   return walls;
 }
 
+/// A square grid of rooms_per_side^2 rooms of room_m, a door of door_m in the middle of every
+/// inner wall: a building whose rooms all look alike (4-fold symmetric as a whole).
+inline std::vector<Segment> building(int rooms_per_side, double room_m = 5.0, double door_m = 1.0) {
+  std::vector<Segment> walls;
+  for (int i = 0; i <= rooms_per_side; ++i) {
+    const double at = i * room_m;
+    for (int j = 0; j < rooms_per_side; ++j) {
+      const double from = j * room_m, door_from = from + (room_m - door_m) / 2, door_to = door_from + door_m;
+      const bool outer = i == 0 || i == rooms_per_side;
+      walls.push_back({{at, from}, {at, outer ? from + room_m : door_from}});
+      if (!outer) walls.push_back({{at, door_to}, {at, from + room_m}});
+      walls.push_back({{from, at}, {outer ? from + room_m : door_from, at}});
+      if (!outer) walls.push_back({{door_to, at}, {from + room_m, at}});
+    }
+  }
+  return walls;
+}
+
 /// Distance along the ray from `origin` in direction `angle` to the nearest segment.
 inline std::optional<double> cast(const std::vector<Segment> &walls, const Eigen::Vector2d &origin,
                                   double angle) {

@@ -127,3 +127,40 @@ TEST_CASE("relocalisation with an empty map or scan reports nothing", "[slam][re
   omnislam::slam::Relocalizer relocalizer(wall_points(omnislam::test::l_room()));
   CHECK(relocalizer.process({}, std::nullopt).state == LocalizationState::kSearching);
 }
+
+TEST_CASE("relocalisation in a building of identical rooms never picks one", "[slam][relocalize]") {
+  // Nine rooms with doors: the building looks the same turned by a quarter about its centre,
+  // so every pose has three twins, in the same room or another; none may be reported.
+  const auto walls = omnislam::test::building(3);
+  const Points2 map = wall_points(walls);
+  std::mt19937_64 rng(13);
+  for (const Eigen::Isometry2d &start : {planar_pose(7.0, 6.5, 0.3), planar_pose(2.0, 1.5, 2.0)}) {
+    omnislam::slam::Relocalizer relocalizer(map);
+    for (const Eigen::Isometry2d &pose : drive(start, 10)) {
+      const auto result = relocalizer.process(omnislam::test::scan_from(walls, pose, rng, 0.01, 6.0), pose);
+      CHECK(result.state == LocalizationState::kSearching);
+    }
+  }
+}
+
+TEST_CASE("relocalisation in a building whose rooms differ finds the room", "[slam][relocalize]") {
+  // The same building with one box placed differently in every room.
+  auto walls = omnislam::test::building(3);
+  for (int room = 0; room < 9; ++room) {
+    const double x0 = (room % 3) * 5.0 + 0.8 + 0.35 * room, y0 = (room / 3) * 5.0 + 3.6 - 0.3 * room;
+    const std::vector<Eigen::Vector2d> box = {{x0, y0}, {x0 + 0.6, y0}, {x0 + 0.6, y0 + 0.4}, {x0, y0 + 0.4}};
+    for (std::size_t i = 0; i < box.size(); ++i) walls.push_back({box[i], box[(i + 1) % box.size()]});
+  }
+  const Points2 map = wall_points(walls);
+  std::mt19937_64 rng(17);
+  omnislam::slam::Relocalizer relocalizer(map);
+  const auto path = drive(planar_pose(11.5, 7.0, -0.4), 10);
+  std::optional<Eigen::Isometry2d> found;
+  std::size_t frame = 0;
+  for (; frame < path.size() && !found; ++frame) {
+    const auto result = relocalizer.process(omnislam::test::scan_from(walls, path[frame], rng, 0.01, 6.0), path[frame]);
+    if (result.state == LocalizationState::kLocalized) found = result.T_map_base;
+  }
+  REQUIRE(found);
+  CHECK(error_m(*found, path[frame - 1]) <= 0.05);
+}

@@ -101,17 +101,27 @@ Points2 CorrelativeMatcher::thinned(const Points2 &scan_base) const {
   return kept;
 }
 
+double CorrelativeMatcher::point_score(const Eigen::Vector2d &point_map) const {
+  const Eigen::Vector2d cell = (point_map - origin_m_) / config_.resolution_m - Eigen::Vector2d(0.5, 0.5);
+  const int x = static_cast<int>(std::floor(cell.x())), y = static_cast<int>(std::floor(cell.y()));
+  const double fx = cell.x() - x, fy = cell.y() - y;
+  return (1.0 - fy) * ((1.0 - fx) * at(0, x, y) + fx * at(0, x + 1, y)) +
+         fy * ((1.0 - fx) * at(0, x, y + 1) + fx * at(0, x + 1, y + 1));
+}
+
 double CorrelativeMatcher::score(const Points2 &scan_base, const Eigen::Isometry2d &T_map_base) const {
   if (empty() || scan_base.empty()) return 0.0;
   double sum = 0.0;
-  for (const Point2 &p : scan_base) {
-    const Eigen::Vector2d cell = (T_map_base * p - origin_m_) / config_.resolution_m - Eigen::Vector2d(0.5, 0.5);
-    const int x = static_cast<int>(std::floor(cell.x())), y = static_cast<int>(std::floor(cell.y()));
-    const double fx = cell.x() - x, fy = cell.y() - y;
-    sum += (1.0 - fy) * ((1.0 - fx) * at(0, x, y) + fx * at(0, x + 1, y)) +
-           fy * ((1.0 - fx) * at(0, x, y + 1) + fx * at(0, x + 1, y + 1));
-  }
+  for (const Point2 &p : scan_base) sum += point_score(T_map_base * p);
   return sum / static_cast<double>(scan_base.size());
+}
+
+double CorrelativeMatcher::log_likelihood(const Points2 &scan_base, const Eigen::Isometry2d &T_map_base,
+                                          double outlier_share) const {
+  double sum = 0.0;
+  for (const Point2 &p : thinned(scan_base))
+    sum += std::log(outlier_share + (1.0 - outlier_share) * (empty() ? 0.0 : point_score(T_map_base * p)));
+  return sum;
 }
 
 std::vector<PoseCandidate> CorrelativeMatcher::search(const Points2 &scan_base, double min_score,

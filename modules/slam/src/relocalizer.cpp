@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numbers>
 
 #include "omnislam/slam/planar_pose.hpp"
@@ -71,9 +72,13 @@ LocalizationResult Relocalizer::process(const Points2 &scan_base,
   for (const PoseCandidate &candidate : candidates) best = std::max(best, candidate.score);
 
   // 3. A tracked hypothesis survives where its refined pose still explains the scan.
-  std::vector<Hypothesis> alive;
   const auto admissible = [&](double score) {
     return score >= config_.min_score && score >= config_.relative_score * best;
+  };
+  std::vector<Hypothesis> alive;
+  std::vector<double> frame_log_likelihood;
+  const auto weigh = [&](const Eigen::Isometry2d &pose) {
+    return config_.point_correlation * matcher_.log_likelihood(scan_base, pose, config_.outlier_share);
   };
   for (Hypothesis hypothesis : hypotheses_) {
     const auto refined = refine(scan_base, hypothesis.T_map_base);
@@ -81,12 +86,13 @@ LocalizationResult Relocalizer::process(const Points2 &scan_base,
     hypothesis.T_map_base = refined->T_model_sample;
     hypothesis.covariance = refined->covariance;
     hypothesis.score = matcher_.score(scan_base, hypothesis.T_map_base);
-    if (!admissible(hypothesis.score)) continue;
+    if (hypothesis.score < config_.min_score) continue;
     ++hypothesis.frames;
-    best = std::max(best, hypothesis.score);
     alive.push_back(hypothesis);
+    frame_log_likelihood.push_back(weigh(hypothesis.T_map_base));
   }
-  // 4. Every other candidate is a new hypothesis.
+  // 4. Every other candidate is a new hypothesis, with no history.
+  const std::size_t tracked = alive.size();
   for (const PoseCandidate &candidate : candidates) {
     const auto known = [&](const Eigen::Isometry2d &pose) {
       return std::any_of(alive.begin(), alive.end(),
@@ -97,12 +103,25 @@ LocalizationResult Relocalizer::process(const Points2 &scan_base,
     if (!refined || known(refined->T_model_sample)) continue;
     const double score = matcher_.score(scan_base, refined->T_model_sample);
     if (!admissible(score)) continue;
-    best = std::max(best, score);
-    alive.push_back({refined->T_model_sample, refined->covariance, score, 1});
+    alive.push_back({refined->T_model_sample, refined->covariance, score, 0.0, 1});
+    frame_log_likelihood.push_back(weigh(refined->T_model_sample));
   }
+  // Each hypothesis falls behind the frame's best by what this frame says (a new one: by
+  // this frame alone); the leader is at zero, and who trails by the decision margin is out.
+  double frame_best = -std::numeric_limits<double>::infinity();
+  for (const double l : frame_log_likelihood) frame_best = std::max(frame_best, l);
+  double least = std::numeric_limits<double>::infinity();
+  for (std::size_t i = 0; i < alive.size(); ++i) {
+    alive[i].deficit = (i < tracked ? alive[i].deficit : 0.0) + frame_best - frame_log_likelihood[i];
+    least = std::min(least, alive[i].deficit);
+  }
+  const double margin = std::log((1.0 - config_.error_rate) / config_.error_rate);
   hypotheses_.clear();
-  for (const Hypothesis &hypothesis : alive)
-    if (admissible(hypothesis.score)) hypotheses_.push_back(hypothesis);
+  for (Hypothesis &hypothesis : alive) {
+    hypothesis.deficit -= least;
+    best = std::max(best, hypothesis.score);
+    if (hypothesis.deficit <= margin) hypotheses_.push_back(hypothesis);
+  }
 
   // 5. Localized when one hypothesis alone has held for confirm_frames frames.
   result.hypotheses = static_cast<int>(hypotheses_.size());

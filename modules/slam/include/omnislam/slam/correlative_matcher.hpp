@@ -54,11 +54,18 @@ class CorrelativeMatcher {
   /// Mean point score of the scan at a pose (bilinear in the likelihood grid).
   [[nodiscard]] double score(const Points2 &scan_base, const Eigen::Isometry2d &T_map_base) const;
 
+  /// Log-likelihood of the scan at a pose: sum over its points of ln(outlier_share + (1 -
+  /// outlier_share) * score), a point off the map's structure costing at most ln(outlier_share).
+  [[nodiscard]] double log_likelihood(const Points2 &scan_base, const Eigen::Isometry2d &T_map_base,
+                                      double outlier_share) const;
+
   [[nodiscard]] bool empty() const { return width_ == 0; }
 
  private:
   /// Value of level `level` at cell (x, y); 0 outside the grid.
   [[nodiscard]] float at(int level, int x, int y) const;
+  /// Score of one map-frame point, bilinear in the likelihood grid.
+  [[nodiscard]] double point_score(const Eigen::Vector2d &point_map) const;
   [[nodiscard]] Points2 thinned(const Points2 &scan_base) const;
 
   CorrelativeMatcherConfig config_;

@@ -23,12 +23,19 @@ namespace omnislam::slam {
 struct RelocalizerConfig {
   CorrelativeMatcherConfig matcher;
   TrimmedIcpConfig icp;
-  /// A pose is a hypothesis when its mean point score reaches min_score (the scan mostly on
-  /// the map's structure) and relative_score of the frame's best: a wrong pose that a
-  /// repeated structure makes nearly as good stays in the running instead of being beaten
-  /// by noise.
+  /// The search's candidates: a mean point score of at least min_score (the scan mostly on
+  /// the map's structure) and relative_score of the frame's best.
   double min_score = 0.5;
   double relative_score = 0.8;
+  /// Hypotheses then compete on their likelihood, summed over the frames they were tracked:
+  /// each scan point (thinned to the matcher's voxel) is on the map's structure or, with
+  /// probability outlier_share, not (the front-end's wrong points and what changed since the
+  /// map: 5-10% of a scan, measured); neighbouring points share errors, so a frame's sum
+  /// counts point_correlation of its points. A hypothesis falls behind the best by more than
+  /// ln((1 - error_rate) / error_rate) and is dropped (Wald's test at error_rate).
+  double outlier_share = 0.1;
+  double point_correlation = 0.5;
+  double error_rate = 0.01;
   /// Poses closer than this are the same hypothesis.
   double distinct_m = 0.5;
   double distinct_rad = 0.35;
@@ -70,7 +77,8 @@ class Relocalizer {
     Eigen::Isometry2d T_map_base = Eigen::Isometry2d::Identity();
     Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
     double score = 0.0;
-    int frames = 0;  ///< consecutive frames it was confirmed in
+    double deficit = 0.0;  ///< summed log-likelihood behind the best hypothesis (>= 0)
+    int frames = 0;        ///< consecutive frames it was confirmed in
   };
   /// ICP from `guess` against the map; nullopt when the fit is rejected.
   [[nodiscard]] std::optional<TrimmedIcpResult> refine(const Points2 &scan_base,
