@@ -9,8 +9,21 @@
 
 namespace omnislam::slam {
 
+namespace {
+
+CorrelativeMatcherConfig coarse(double resolution_m) {
+  CorrelativeMatcherConfig config;
+  config.resolution_m = config.sigma_m = config.scan_voxel_m = resolution_m;
+  return config;
+}
+
+}  // namespace
+
 Relocalizer::Relocalizer(const Points2 &map_points, RelocalizerConfig config)
-    : config_(config), matcher_(map_points, config.matcher), map_index_(map_points) {}
+    : config_(config),
+      matcher_(map_points, config.matcher),
+      search_matcher_(map_points, coarse(config.search_resolution_m)),
+      map_index_(map_points) {}
 
 void Relocalizer::reset() {
   hypotheses_.clear();
@@ -65,7 +78,7 @@ LocalizationResult Relocalizer::process(const Points2 &scan_base,
 
   // 2. Search the map (or the window) for every pose that explains the scan nearly as well
   //    as the best.
-  const std::vector<PoseCandidate> candidates = matcher_.search(
+  const std::vector<PoseCandidate> candidates = search_matcher_.search(
       scan_base, config_.min_score, config_.relative_score, config_.distinct_m, config_.distinct_rad, window);
   result.searched_poses = static_cast<int>(candidates.size());
   double best = 0.0;
@@ -91,9 +104,21 @@ LocalizationResult Relocalizer::process(const Points2 &scan_base,
     alive.push_back(hypothesis);
     frame_log_likelihood.push_back(weigh(hypothesis.T_map_base));
   }
-  // 4. Every other candidate is a new hypothesis, with no history.
-  const std::size_t tracked = alive.size();
+  // 4. Every other candidate is a new hypothesis, with no history, unless the coarse grid
+  //    already puts it out of the running (no refinement for those: in a building of alike
+  //    rooms most candidates are).
+  const double margin = std::log((1.0 - config_.error_rate) / config_.error_rate);
+  std::vector<double> coarse_log_likelihood;
+  double coarse_best = -std::numeric_limits<double>::infinity();
   for (const PoseCandidate &candidate : candidates) {
+    coarse_log_likelihood.push_back(config_.point_correlation *
+                                    search_matcher_.log_likelihood(scan_base, candidate.T_map_base, config_.outlier_share));
+    coarse_best = std::max(coarse_best, coarse_log_likelihood.back());
+  }
+  const std::size_t tracked = alive.size();
+  for (std::size_t c = 0; c < candidates.size(); ++c) {
+    const PoseCandidate &candidate = candidates[c];
+    if (coarse_best - coarse_log_likelihood[c] > margin) continue;
     const auto known = [&](const Eigen::Isometry2d &pose) {
       return std::any_of(alive.begin(), alive.end(),
                          [&](const Hypothesis &h) { return same_pose(h.T_map_base, pose); });
@@ -115,7 +140,6 @@ LocalizationResult Relocalizer::process(const Points2 &scan_base,
     alive[i].deficit = (i < tracked ? alive[i].deficit : 0.0) + frame_best - frame_log_likelihood[i];
     least = std::min(least, alive[i].deficit);
   }
-  const double margin = std::log((1.0 - config_.error_rate) / config_.error_rate);
   hypotheses_.clear();
   for (Hypothesis &hypothesis : alive) {
     hypothesis.deficit -= least;

@@ -21,7 +21,12 @@
 namespace omnislam::slam {
 
 struct RelocalizerConfig {
+  /// Scores and likelihoods of hypotheses (the map's 0.05 m fusion scale).
   CorrelativeMatcherConfig matcher;
+  /// The whole-map search runs on a grid twice as coarse (cell, fall-off and scan thinning
+  /// 0.1 m: a quarter of the cells, half the yaws); Trimmed ICP brings its candidates to the
+  /// map's precision.
+  double search_resolution_m = 0.1;
   TrimmedIcpConfig icp;
   /// The search's candidates: a mean point score of at least min_score (the scan mostly on
   /// the map's structure) and relative_score of the frame's best.
@@ -87,6 +92,7 @@ class Relocalizer {
 
   RelocalizerConfig config_;
   CorrelativeMatcher matcher_;
+  CorrelativeMatcher search_matcher_;
   NearestNeighbors map_index_;
   std::vector<Hypothesis> hypotheses_;
   std::optional<Eigen::Isometry2d> last_T_odom_base_;
