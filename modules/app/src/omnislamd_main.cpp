@@ -6,6 +6,7 @@
 
 #include <CLI/CLI.hpp>
 #include <chrono>
+#include <cmath>
 #include <csignal>
 #include <cstdlib>
 #include <exception>
@@ -150,7 +151,14 @@ int run_service(const std::string &config_file) {
   const bool expects_odometry = service.input.odometry != "none";
 
   RunRecord run;
-  grid::OccupancyGrid occupancy;          // rt/map, and map.yaml + map.pgm in output_dir
+  grid::OccupancyGrid occupancy;  // rt/map, snapshots, and map.yaml + map.pgm in output_dir
+  if (resumed && resumed->grid) {
+    if (std::abs(resumed->grid->resolution_m - occupancy.config().resolution_m) < 1e-9)
+      occupancy.seed(*resumed->grid);
+    else
+      spdlog::warn("the snapshot's occupancy grid has {} m cells, not {} m: the grid starts empty",
+                   resumed->grid->resolution_m, occupancy.config().resolution_m);
+  }
   std::optional<FrameRecord> last_frame;  // for the final snapshot
   pipeline::Sinks sinks;
   sinks.frame = [&](const pipeline::Frame &frame) {
@@ -178,7 +186,7 @@ int run_service(const std::string &config_file) {
     }
     if (frame.dropped_before > 0)
       spdlog::debug("{} frames dropped before frame {}", frame.dropped_before, frame.sequence);
-    const bool gridded = publisher || !service.output_dir.empty();
+    const bool gridded = publisher || !service.output_dir.empty() || snapshots;
     if (gridded && !frame.skipped())
       occupancy.add_scan(frame.estimate.T_map_base, scan_rays(frame.scan, config.scan.camera));
     if (tf)
@@ -196,7 +204,8 @@ int run_service(const std::string &config_file) {
     if (frame.map) counts.map_points.store(frame.map->size(), std::memory_order_relaxed);
     last_frame = frame_record(frame);
     if (frame.state_due && snapshots)
-      snapshots->submit(make_snapshot(*last_frame, *frame.map, frame.map_integrations, n, config_hash));
+      snapshots->submit(
+          make_snapshot(*last_frame, *frame.map, frame.map_integrations, n, config_hash, occupancy.image()));
     if (!service.output_dir.empty()) run.frames.push_back(*last_frame);
   };
   sinks.profile = [&](const pipeline::ProfileSnapshot &profile) {
@@ -239,17 +248,18 @@ int run_service(const std::string &config_file) {
   status.last_error = pipeline.error();
   status.state = pipeline.error().empty() ? dds::ServiceState::kStopped : dds::ServiceState::kFailed;
   const double last_stamp = last_frame ? last_frame->t_s : status.stamp_s;
+  const grid::GridImage final_grid = occupancy.image();  // empty when nothing was gridded
   if (snapshots && last_frame) {
     // The final state, written before anything else can fail.
     snapshots->submit(make_snapshot(*last_frame, pipeline.slam().map().points(),
-                                    pipeline.slam().map().integrations(), counts.totals, config_hash));
+                                    pipeline.slam().map().integrations(), counts.totals, config_hash,
+                                    final_grid));
   }
   if (snapshots) {
     snapshots->finish();
     if (!snapshots->last_error().empty()) status.last_error = snapshots->last_error();
     spdlog::info("{} snapshots written to {}", snapshots->written(), snapshots->file().string());
   }
-  const grid::GridImage final_grid = occupancy.image();  // empty when nothing was gridded
   if (publisher) {
     publisher->map(last_stamp, pipeline.slam().map().points());  // the final state
     if (final_grid.width > 0) publisher->grid(last_stamp, final_grid);
