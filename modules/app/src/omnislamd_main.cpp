@@ -118,10 +118,13 @@ int run_service(const std::string &config_file) {
   std::optional<dds::Publisher> publisher;
   std::optional<TfBroadcaster> tf;
   std::shared_ptr<dds::OdometryReader> odometry;
+  std::shared_ptr<dds::InitialPoseReader> initial_pose;
   if (service.dds.enabled) {
     participant.emplace(dds::DdsConfig{service.dds.domain_id, service.dds.config});
     publisher.emplace(*participant);
     if (service.dds.tf.enabled) tf.emplace(*participant, service.dds.tf, service.input.odometry != "none");
+    if (!service.dds.initial_pose_topic.empty())
+      initial_pose = std::make_shared<dds::InitialPoseReader>(*participant, service.dds.initial_pose_topic);
     if (service.input.odometry == "dds") {
       odometry = std::make_shared<dds::OdometryReader>(
           *participant, service.input.odometry_topic,
@@ -222,7 +225,12 @@ int run_service(const std::string &config_file) {
     pipeline.resume(resumed->points, resumed->map_integrations, resumed->T_map_base, resumed->covariance,
                     resumed->T_odom_base);
   }
-  pipeline.start(checked_source(input.source, config.scan.camera, status));
+  const auto initial_pose_counts = std::make_shared<InitialPoseCounts>();
+  pipeline::FrameSource source = checked_source(input.source, config.scan.camera, status);
+  if (initial_pose)
+    source =
+        with_initial_pose(std::move(source), initial_pose, service.dds.tf.map_frame, initial_pose_counts);
+  pipeline.start(std::move(source));
   status.state = dds::ServiceState::kRunning;
   status.stamp_s = system_time_s();
   if (publisher) publisher->status(status);
@@ -246,6 +254,7 @@ int run_service(const std::string &config_file) {
   status.frames_out = pipeline.frames_out();
   status.frames_dropped = pipeline.frames_dropped();
   status.last_error = pipeline.error();
+  if (status.last_error.empty()) status.last_error = initial_pose_counts->last_error();
   status.state = pipeline.error().empty() ? dds::ServiceState::kStopped : dds::ServiceState::kFailed;
   const double last_stamp = last_frame ? last_frame->t_s : status.stamp_s;
   const grid::GridImage final_grid = occupancy.image();  // empty when nothing was gridded
@@ -274,6 +283,11 @@ int run_service(const std::string &config_file) {
     OutputWriter(service.output_dir).write_all(run, pipeline.slam().map(), info);
     if (final_grid.width > 0)
       io::write_nav2_map(std::filesystem::path(service.output_dir) / "map.yaml", final_grid);
+  }
+  if (initial_pose) {
+    spdlog::info("{} initial poses on {} applied, {} in another frame ignored, {} non-finite dropped",
+                 initial_pose_counts->applied.load(), service.dds.initial_pose_topic,
+                 initial_pose_counts->rejected.load(), initial_pose->rejected());
   }
   if (odometry && odometry->rejected() > 0)
     spdlog::warn("{} odometry samples on {} had a non-finite stamp or pose and were dropped",

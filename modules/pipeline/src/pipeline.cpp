@@ -134,6 +134,7 @@ void Pipeline::capture_loop(FrameSource source) {
   const Clock::time_point start = Clock::now();
   std::uint64_t sequence = 0;
   std::uint32_t dropped_run = 0;
+  std::optional<Frame::PoseReset> carried_reset;
   while (!stop_.load(std::memory_order_relaxed)) {
     if (config_.input_rate_hz > 0.0) {
       const auto due = start + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(
@@ -158,10 +159,13 @@ void Pipeline::capture_loop(FrameSource source) {
     frame->sequence = ++sequence;
     frame->timings.stage_ms[kRead] = ms_between(before, frame->captured);
     frame->dropped_before = dropped_run;
+    if (!frame->pose_reset) frame->pose_reset = std::move(carried_reset);  // a dropped frame's
+    carried_reset.reset();
     frame->enqueued = frame->captured;
     captured_.fetch_add(1, std::memory_order_relaxed);
     if (config_.mode == Mode::kLive) {
       if (!out.try_push(frame)) {
+        carried_reset = std::move(frame->pose_reset);
         ++dropped_run;
         dropped_.fetch_add(1, std::memory_order_relaxed);
         continue;
@@ -230,6 +234,7 @@ void Pipeline::slam_loop() {
     busy(3, true);
     stall_if_asked(3, *frame);
     StepClock clock(*frame);
+    if (frame->pose_reset) slam_.set_pose(frame->pose_reset->T_map_base, frame->pose_reset->covariance);
     frame->estimate = slam_.process(scan_points(frame->scan),
                                     frame->has_odometry ? std::optional(frame->T_odom_base) : std::nullopt);
     clock.lap(kSlam);
