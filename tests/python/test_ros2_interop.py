@@ -161,6 +161,15 @@ def test_golden_bytes_of_every_published_type(run):
     assert [s.name for s in profile.stages][:2] == ["read", "unwarp"]
 
 
+def test_golden_files_of_the_read_types_are_rosbags_output():
+    """tests/dds/golden/*.hex, against which test_dds_golden checks Cyclone's bytes from our
+    IDL, are what rosbags serialises now."""
+    sys.path.insert(0, str(REPO / "tests" / "python"))
+    from golden_cdr import GOLDEN, golden_hex
+    for name, text in golden_hex().items():
+        assert (GOLDEN / f"{name}.hex").read_text().strip() == text, f"{name}.hex: run tests/python/golden_cdr.py"
+
+
 def test_golden_bytes_of_the_types_omnislamd_reads():
     store = typestore()
     header = m.Header_(stamp=m.Time_(sec=1700000000, nanosec=250000000), frame_id="odom")
