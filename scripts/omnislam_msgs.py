@@ -158,6 +158,21 @@ class PointCloud2_(IdlStruct, typename="sensor_msgs::msg::dds_::PointCloud2_"):
 
 @dataclass
 @annotate.final
+class LaserScan_(IdlStruct, typename="sensor_msgs::msg::dds_::LaserScan_"):
+    header: Header_
+    angle_min: types.float32
+    angle_max: types.float32
+    angle_increment: types.float32
+    time_increment: types.float32
+    scan_time: types.float32
+    range_min: types.float32
+    range_max: types.float32
+    ranges: types.sequence[types.float32]
+    intensities: types.sequence[types.float32]
+
+
+@dataclass
+@annotate.final
 class StageStats_(IdlStruct, typename="omnislam::msg::dds_::StageStats_"):
     name: str
     count: types.uint64

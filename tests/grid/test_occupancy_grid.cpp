@@ -59,3 +59,26 @@ TEST_CASE("occupancy grid: one free pass over a boundary cell does not clear it;
   CHECK(at(image, 0.05, 0.85) == -1);   // missed once: P 0.40, not yet free
   CHECK(grid.image().width == 1);
 }
+
+TEST_CASE("occupancy grid: seeded from a trinary image (a resumed snapshot) gives it back, then learns",
+          "[grid]") {
+  OccupancyGrid first({.resolution_m = 0.1});
+  const Eigen::Isometry2d pose = Eigen::Translation2d(-0.35, 0.25) * Eigen::Rotation2Dd(0.3);
+  first.add_scan(pose, std::vector<Ray>{{0.0, 1.0, 1.0}, {M_PI / 2, kNaN, 0.5}, {-2.0, 0.7, 0.7}});
+  const GridImage saved = first.image();
+  REQUIRE(saved.width > 1);
+
+  OccupancyGrid resumed({.resolution_m = 0.1});
+  resumed.seed(saved);
+  const GridImage again = resumed.image();
+  CHECK(again.width == saved.width);
+  CHECK(again.height == saved.height);
+  CHECK(again.origin_m.isApprox(saved.origin_m, 1e-12));
+  CHECK(again.cells == saved.cells);
+
+  // A seeded occupied cell is at the confidence bound: three free passes (-0.41 each from
+  // 3.48) leave it occupied.
+  const Eigen::Vector2d wall = pose * Eigen::Vector2d(1.0, 0.0);
+  for (int i = 0; i < 3; ++i) resumed.add_scan(pose, std::vector<Ray>{{0.0, kNaN, 1.5}});
+  CHECK(at(resumed.image(), wall.x(), wall.y()) == 100);
+}

@@ -59,8 +59,10 @@ TEST_CASE("snapshot: the odometry pose round-trips; version-1 files (without it)
   without.T_odom_base.reset();
   CHECK_FALSE(omnislam::io::decode_snapshot(omnislam::io::encode_snapshot(without), "none.snap").T_odom_base);
 
-  // Version 1: the same bytes without the 32-byte odometry block after map_integrations.
+  // Version 1: the same bytes without the 32-byte odometry block after map_integrations
+  // (and without version 3's grid section, 8 bytes when there is no grid).
   std::vector<std::uint8_t> v1 = omnislam::io::encode_snapshot(written);
+  v1.resize(v1.size() - 8);
   const std::size_t odometry_at = 24 + 8 + 4 * 8 + 9 * 8 + 5 * 8 + 8;
   v1.erase(v1.begin() + static_cast<std::ptrdiff_t>(odometry_at),
            v1.begin() + static_cast<std::ptrdiff_t>(odometry_at + 32));
@@ -78,8 +80,8 @@ TEST_CASE("snapshot: written atomically and read back exactly", "[io][snapshot]"
   const fs::path dir = scratch("roundtrip");
   const Snapshot written = example();
   omnislam::io::write_snapshot(dir / "state.snap", written);
-  // 24-byte header + 200-byte fixed payload + 24 bytes per point; no temporary left over.
-  CHECK(fs::file_size(dir / "state.snap") == 24 + 200 + 24 * 50);
+  // 24-byte header + 200-byte fixed payload + 24 bytes per point + has_grid 0; no temporary left over.
+  CHECK(fs::file_size(dir / "state.snap") == 24 + 200 + 24 * 50 + 8);
   CHECK(std::distance(fs::directory_iterator(dir), fs::directory_iterator()) == 1);
 
   const Snapshot read = omnislam::io::read_snapshot(dir / "state.snap");
@@ -130,7 +132,7 @@ TEST_CASE("snapshot: truncation, bit flips, other versions and bad values are re
   }
   const std::vector<std::uint8_t> header_only(good.begin(), good.begin() + 30);
   CHECK_THROWS_WITH(omnislam::io::decode_snapshot(header_only, "cut.snap"),
-                    Catch::Contains("cut.snap: truncated") && Catch::Contains("1400 payload bytes") &&
+                    Catch::Contains("cut.snap: truncated") && Catch::Contains("1408 payload bytes") &&
                         Catch::Contains("has 6"));
   // A flipped bit anywhere after the magic fails the checksum (or, in the size field, the length).
   for (std::size_t i = 8; i < good.size(); i += 37) {
@@ -152,13 +154,13 @@ TEST_CASE("snapshot: truncation, bit flips, other versions and bad values are re
 
 TEST_CASE("snapshot: a future version or impossible values are named even with a valid checksum",
           "[io][snapshot]") {
-  // A version-3 file (as a newer build would write it) has a valid CRC of its own.
-  std::vector<std::uint8_t> v3 = omnislam::io::encode_snapshot(example());
-  v3[8] = 3;
-  omnislam::test::reseal_snapshot(v3);
+  // A version-4 file (as a newer build would write it) has a valid CRC of its own.
+  std::vector<std::uint8_t> v4 = omnislam::io::encode_snapshot(example());
+  v4[8] = 4;
+  omnislam::test::reseal_snapshot(v4);
   CHECK_THROWS_WITH(
-      omnislam::io::decode_snapshot(v3, "v3.snap"),
-      Catch::Equals("v3.snap: unsupported snapshot version 3 (this build reads versions 1 to 2)"));
+      omnislam::io::decode_snapshot(v4, "v4.snap"),
+      Catch::Equals("v4.snap: unsupported snapshot version 4 (this build reads versions 1 to 3)"));
 
   Snapshot bad = example();
   bad.points[3].hits = 0;
@@ -220,4 +222,64 @@ TEST_CASE("config file hash: FNV-1a of the bytes", "[io][snapshot]") {
   CHECK(omnislam::io::config_file_hash("") == 0);
   CHECK(omnislam::io::config_file_hash(dir / "empty.yaml") == 0xcbf29ce484222325ull);
   CHECK(omnislam::io::config_file_hash(dir / "a.yaml") == 0xaf63dc4c8601ec8cull);
+}
+
+namespace {
+
+omnislam::grid::GridImage example_grid() {
+  omnislam::grid::GridImage g;
+  g.width = 7;
+  g.height = 3;
+  g.resolution_m = 0.05;
+  g.origin_m = {-1.25, 0.4};
+  for (int i = 0; i < g.width * g.height; ++i) g.cells.push_back(i % 3 == 0 ? -1 : (i % 3 == 1 ? 0 : 100));
+  return g;
+}
+
+}  // namespace
+
+TEST_CASE("snapshot: version 3 carries the occupancy grid; version-2 files (without it) still read",
+          "[io][snapshot]") {
+  Snapshot written = example();
+  written.grid = example_grid();
+  const std::vector<std::uint8_t> v3 = omnislam::io::encode_snapshot(written);
+  CHECK(v3.size() == 24 + 200 + 24 * 50 + 8 + 32 + 21);
+  const Snapshot read = omnislam::io::decode_snapshot(v3, "grid.snap");
+  CHECK(read.version == 3);
+  REQUIRE(read.grid);
+  CHECK(read.grid->width == 7);
+  CHECK(read.grid->height == 3);
+  CHECK(read.grid->resolution_m == 0.05);
+  CHECK(read.grid->origin_m == Eigen::Vector2d(-1.25, 0.4));
+  CHECK(read.grid->cells == written.grid->cells);
+  CHECK(read.points.size() == 50);
+
+  // Version 2: version 3 without the grid section.
+  std::vector<std::uint8_t> v2 = omnislam::io::encode_snapshot(example());
+  v2.resize(v2.size() - 8);
+  v2[8] = 2;
+  omnislam::test::reseal_snapshot(v2);
+  const Snapshot old = omnislam::io::decode_snapshot(v2, "v2.snap");
+  CHECK(old.version == 2);
+  CHECK_FALSE(old.grid);
+  CHECK(old.points.size() == 50);
+
+  // A cell that is not -1, 0 or 100, and a grid shorter than announced, are named.
+  omnislam::grid::GridImage odd_cell = example_grid(), short_grid = example_grid();
+  odd_cell.cells[5] = 42;
+  short_grid.cells.pop_back();
+  Snapshot bad = example();
+  bad.grid = std::move(odd_cell);
+  CHECK_THROWS_WITH(omnislam::io::decode_snapshot(omnislam::io::encode_snapshot(bad), "cell.snap"),
+                    Catch::Equals("cell.snap: occupancy grid cell 5 is 42 (not -1, 0 or 100)"));
+  bad.grid = std::move(short_grid);
+  CHECK_THROWS_WITH(
+      omnislam::io::decode_snapshot(omnislam::io::encode_snapshot(bad), "short.snap"),
+      Catch::Contains("short.snap: the occupancy grid announces 21 cells, the file holds 20 bytes"));
+  // Every truncation of a file with a grid is caught too.
+  for (std::size_t length = v3.size() - 60; length < v3.size(); ++length) {
+    std::vector<std::uint8_t> cut(v3.begin(), v3.begin() + static_cast<long>(length));
+    omnislam::test::reseal_snapshot(cut);
+    CHECK_THROWS_AS(omnislam::io::decode_snapshot(cut, "cut.snap"), SnapshotError);
+  }
 }

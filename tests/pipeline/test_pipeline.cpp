@@ -2,6 +2,7 @@
 #include <catch2/catch.hpp>
 #include <chrono>
 #include <cmath>
+#include <optional>
 #include <thread>
 #include <vector>
 
@@ -151,4 +152,57 @@ TEST_CASE("pipeline: a throwing sink ends the run with its error, a busy stage i
   REQUIRE(stuck.has_value());
   CHECK(Pipeline::kThreads[*stuck] == "publish");
   CHECK(pipeline.error() == "output: disk full");
+}
+
+TEST_CASE("pipeline: an operator's pose reaches SLAM with its frame, or with the next one when dropped") {
+  constexpr std::uint64_t kFrames = 400;
+  constexpr std::uint64_t kEvery = 7;  // frames 3, 10, 17, ... carry a pose reset to x = 100 + index
+  auto next = std::make_shared<std::uint64_t>(0);
+  FrameSource source = [next]() -> FramePtr {
+    if (*next >= kFrames) return nullptr;
+    std::this_thread::sleep_for(100us);
+    const std::uint64_t index = (*next)++;
+    auto frame = std::make_unique<Frame>();
+    frame->stamp_s = static_cast<double>(index) * 0.01;
+    frame->T_odom_base = odometry_at(index);
+    frame->has_odometry = true;
+    if (index % kEvery == 3) {
+      frame->pose_reset =
+          Frame::PoseReset{omnislam::slam::planar_pose(100.0 + static_cast<double>(index), 0.0, 0.0),
+                           Eigen::Matrix3d::Identity()};
+    }
+    return frame;
+  };
+  std::vector<Seen> seen;
+  PipelineConfig config;
+  config.mode = Mode::kLive;
+  config.queue_capacity = 2;
+  Sinks sinks;
+  sinks.frame = [&](const Frame &f) {
+    seen.push_back({f.sequence, f.dropped_before, f.estimate.T_map_base, f.T_odom_base, 0});
+    std::this_thread::sleep_for(1ms);  // a slow consumer: capture drops
+  };
+  Pipeline pipeline({}, {}, config, sinks);
+  pipeline.run(std::move(source));
+  REQUIRE(pipeline.frames_dropped() > 0);
+  // A delivered frame after a reset (its own, or the newest of the frames dropped just before
+  // it) is predicted exactly there: empty scans, and the odometry chain restarts at the reset.
+  std::uint64_t previous = 0, applied = 0, carried = 0;
+  bool all_applied = true;
+  for (const Seen &s : seen) {
+    std::optional<std::uint64_t> newest;
+    for (std::uint64_t index = previous; index < s.sequence; ++index)  // sequences previous+1..s.sequence
+      if (index % kEvery == 3) newest = index;
+    if (newest) {
+      ++applied;
+      carried += *newest + 1 != s.sequence ? 1 : 0;
+      all_applied = all_applied && std::abs(s.T_map_base.translation().x() - (100.0 + *newest)) < 1e-9 &&
+                    std::abs(s.T_map_base.translation().y()) < 1e-9;
+    }
+    previous = s.sequence;
+  }
+  INFO(applied << " resets applied, " << carried << " of them carried from a dropped frame");
+  CHECK(all_applied);
+  CHECK(applied > 0);
+  CHECK(carried > 0);
 }

@@ -203,3 +203,45 @@ TEST_CASE("resume with the saved odometry pose predicts the first frame from the
   CHECK_FALSE(standing_still.integrated);
   CHECK(position_error(standing_still.T_map_base, truth[next]) > 0.5);
 }
+
+TEST_CASE("set_pose (rt/initialpose): before the first frame the map starts at the given pose",
+          "[slam][resume]") {
+  const auto walls = omnislam::test::l_room();
+  std::mt19937_64 rng(11);
+  const Eigen::Isometry2d start = pose(2.0, 0.3, 0.4);
+  Slam slam;
+  slam.set_pose(start, Eigen::Matrix3d::Identity() * 0.01);
+  const auto first = slam.process(omnislam::test::scan_from(walls, pose(0, 0, 0), rng), pose(0, 0, 0));
+  CHECK(first.T_map_base.isApprox(start, 1e-12));
+  // The next frame, 0.2 m further along the robot's heading, is tracked in that map frame.
+  const auto next = slam.process(omnislam::test::scan_from(walls, pose(0.2, 0, 0), rng), pose(0.2, 0, 0));
+  CHECK(next.integrated);
+  CHECK(position_error(next.T_map_base, start * pose(0.2, 0, 0)) < 0.02);
+}
+
+TEST_CASE("set_pose (rt/initialpose): mid-run, the next frame starts from it and the map is kept",
+          "[slam][resume]") {
+  const auto truth = tour();
+  const std::size_t half = truth.size() / 2;
+  Slam slam;
+  const Track first_half = run(slam, truth, 0, half, 6);
+  const int integrations = slam.map().integrations();
+  const std::size_t points = slam.map().points().size();
+
+  // A frame with no scan points follows the prediction exactly: the operator's pose.
+  const Eigen::Isometry2d given = truth[half] * pose(0.08, -0.05, 0.05);
+  slam.set_pose(given, Eigen::Matrix3d::Identity() * 0.01);
+  const auto blind = slam.process({}, pose(100, 100, 2));  // an odometry frame of its own
+  CHECK(blind.T_map_base.isApprox(given, 1e-12));
+  CHECK_FALSE(blind.integrated);
+  CHECK(slam.map().integrations() == integrations);
+  CHECK(slam.map().points().size() == points);
+
+  // Again, with odometry in yet another frame: tracking resumes on the kept map.
+  slam.set_pose(given, Eigen::Matrix3d::Identity() * 0.01);
+  const Track second_half = run(slam, truth, half, truth.size(), 7);
+  INFO("first half max " << first_half.max_error_m << " m, after set_pose max " << second_half.max_error_m
+                         << " m");
+  CHECK(second_half.max_error_m < 0.05);
+  CHECK(slam.map().integrations() > integrations);
+}

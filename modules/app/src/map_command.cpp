@@ -2,14 +2,18 @@
 #include "omnislam/slam/planar_pose.hpp"
 
 #include <cinttypes>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <numbers>
 #include <string>
 
+#include "omnislam/grid/occupancy_grid.hpp"
+#include "omnislam/io/grid_files.hpp"
 #include "omnislam/io/poses.hpp"
 #include "omnislam/io/run_files.hpp"
 #include "omnislam/io/snapshot.hpp"
@@ -39,6 +43,12 @@ void print_info(const std::filesystem::path &file) {
   std::printf("frames: %" PRIu64 ", integrated %" PRIu64 ", not integrated %" PRIu64 ", skipped %" PRIu64
               ", dropped %" PRIu64 "\n",
               n.frames, n.integrated, n.not_integrated, n.skipped, n.dropped);
+  if (s.grid) {
+    std::printf("occupancy grid: %d x %d cells at %.3f m, origin (%.3f, %.3f) m\n", s.grid->width,
+                s.grid->height, s.grid->resolution_m, s.grid->origin_m.x(), s.grid->origin_m.y());
+  } else {
+    std::printf("occupancy grid: none\n");
+  }
 }
 
 // The last row of covariance.csv ("frame,t,xx,xy,yy,xyaw,yyaw,yawyaw"), or zero.
@@ -81,9 +91,10 @@ void save(const std::filesystem::path &run_dir, const std::filesystem::path &fil
   for (const io::MapPointRecord &p : io::read_map_csv(run_dir / "map.csv")) {
     s.points.push_back({{p.x_m, p.y_m}, p.hits, 0});
   }
+  if (std::filesystem::exists(run_dir / "map.yaml")) s.grid = io::read_nav2_map(run_dir / "map.yaml");
   io::write_snapshot(file, s);
-  std::printf("saved %zu map points and the pose of frame %zu to %s\n", s.points.size(), trajectory.size(),
-              file.c_str());
+  std::printf("saved %zu map points%s and the pose of frame %zu to %s\n", s.points.size(),
+              s.grid ? ", the occupancy grid" : "", trajectory.size(), file.c_str());
 }
 
 void load(const std::filesystem::path &file, const std::filesystem::path &out_dir) {
@@ -97,6 +108,55 @@ void load(const std::filesystem::path &file, const std::filesystem::path &out_di
   io::write_tum_file(out_dir / "pose.tum", {io::to_stamped(s.t_s, s.T_map_base)});
   std::printf("wrote %zu map points to %s (map.csv, map.ply) and the pose to pose.tum\n", records.size(),
               out_dir.c_str());
+}
+
+// The grid of a snapshot without one (versions 1 and 2, or a writer that had none): each
+// map point's cell occupied, everything else unknown; no free space is invented.
+grid::GridImage grid_of_hits(const std::vector<slam::MapPoint> &points, double resolution_m) {
+  grid::GridConfig config;
+  config.resolution_m = resolution_m;
+  grid::OccupancyGrid occupancy(config);
+  std::vector<grid::Ray> rays;
+  rays.reserve(points.size());
+  for (const slam::MapPoint &p : points) {
+    rays.push_back({std::atan2(p.position_m.y(), p.position_m.x()), p.position_m.norm(),
+                    std::numeric_limits<double>::quiet_NaN()});
+  }
+  occupancy.add_scan(Eigen::Isometry2d::Identity(), rays);
+  return occupancy.image();
+}
+
+// map.yaml + map.pgm from a snapshot (its grid, or its points when it has none) or from a
+// replay's output directory (its map.yaml, read by nav2_map_server's trinary rules).
+void export_map(const std::filesystem::path &source, const std::filesystem::path &out_dir,
+                double resolution_m) {
+  if (!std::filesystem::exists(source))
+    throw std::runtime_error(source.string() + ": no such file or directory");
+  grid::GridImage image;
+  if (std::filesystem::is_directory(source)) {
+    const std::filesystem::path yaml = source / "map.yaml";
+    if (!std::filesystem::exists(yaml)) {
+      throw std::runtime_error(source.string() +
+                               ": no map.yaml (not an omnislam replay or omnislamd output directory)");
+    }
+    image = io::read_nav2_map(yaml);
+  } else {
+    const io::Snapshot s = io::read_snapshot(source);
+    if (s.grid) {
+      image = *s.grid;
+    } else {
+      std::fprintf(stderr,
+                   "note: %s (snapshot version %u) holds no occupancy grid: exporting its %zu map points as "
+                   "occupied cells at %.3f m; free space is unknown\n",
+                   source.c_str(), s.version, s.points.size(), resolution_m);
+      image = grid_of_hits(s.points, resolution_m);
+    }
+  }
+  if (image.width <= 0) throw std::runtime_error(source.string() + ": the map is empty");
+  std::filesystem::create_directories(out_dir);
+  io::write_nav2_map(out_dir / "map.yaml", image);
+  std::printf("wrote a %d x %d grid at %g m to %s (map.yaml, map.pgm)\n", image.width, image.height,
+              image.resolution_m, out_dir.c_str());
 }
 
 }  // namespace
@@ -128,6 +188,24 @@ void add_map_command(CLI::App &app) {
   load_command->add_option("file", *load_file, "snapshot file")->required();
   load_command->add_option("--out", *load_dir, "output directory")->required();
   load_command->callback([load_file, load_dir] { load(*load_file, *load_dir); });
+
+  struct ExportOptions {
+    std::string source, out_dir;
+    double resolution_m = grid::GridConfig{}.resolution_m;
+  };
+  auto export_options = std::make_shared<ExportOptions>();
+  auto *export_command = map->add_subcommand(
+      "export", "write map.yaml + map.pgm (nav2_map_server) from a snapshot or a replay's output directory");
+  export_command->add_option("source", export_options->source, "snapshot file or replay output directory")
+      ->required();
+  export_command->add_option("--out", export_options->out_dir, "output directory")->required();
+  export_command
+      ->add_option("--resolution", export_options->resolution_m,
+                   "cell size (m) for a snapshot without an occupancy grid (its points only)")
+      ->check(CLI::PositiveNumber);
+  export_command->callback([export_options] {
+    export_map(export_options->source, export_options->out_dir, export_options->resolution_m);
+  });
 }
 
 }  // namespace omnislam::app

@@ -6,6 +6,7 @@
 
 #include <CLI/CLI.hpp>
 #include <chrono>
+#include <cmath>
 #include <csignal>
 #include <cstdlib>
 #include <exception>
@@ -124,10 +125,13 @@ int run_service(const std::string &config_file) {
   std::optional<dds::Publisher> publisher;
   std::optional<TfBroadcaster> tf;
   std::shared_ptr<dds::OdometryReader> odometry;
+  std::shared_ptr<dds::InitialPoseReader> initial_pose;
   if (service.dds.enabled) {
     participant.emplace(dds::DdsConfig{service.dds.domain_id, service.dds.config});
     publisher.emplace(*participant);
     if (service.dds.tf.enabled) tf.emplace(*participant, service.dds.tf, service.input.odometry != "none");
+    if (!service.dds.initial_pose_topic.empty())
+      initial_pose = std::make_shared<dds::InitialPoseReader>(*participant, service.dds.initial_pose_topic);
     if (service.input.odometry == "dds") {
       odometry = std::make_shared<dds::OdometryReader>(
           *participant, service.input.odometry_topic,
@@ -161,7 +165,14 @@ int run_service(const std::string &config_file) {
   RunRecord run;
   bool posed = !search_start;  // a frame has had a pose (set by the publish thread; read after join)
   std::uint64_t not_localized = 0;
-  grid::OccupancyGrid occupancy;          // rt/map, and map.yaml + map.pgm in output_dir
+  grid::OccupancyGrid occupancy;  // rt/map, snapshots, and map.yaml + map.pgm in output_dir
+  if (resumed && resumed->grid) {
+    if (std::abs(resumed->grid->resolution_m - occupancy.config().resolution_m) < 1e-9)
+      occupancy.seed(*resumed->grid);
+    else
+      spdlog::warn("the snapshot's occupancy grid has {} m cells, not {} m: the grid starts empty",
+                   resumed->grid->resolution_m, occupancy.config().resolution_m);
+  }
   std::optional<FrameRecord> last_frame;  // for the final snapshot
   pipeline::Sinks sinks;
   sinks.frame = [&](const pipeline::Frame &frame) {
@@ -202,7 +213,7 @@ int run_service(const std::string &config_file) {
       if (publisher)
         publisher->status({system_time_s(), dds::ServiceState::kRunning, frame.sequence, 0, 0, ""});
     }
-    const bool gridded = publisher || !service.output_dir.empty();
+    const bool gridded = publisher || !service.output_dir.empty() || snapshots;
     if (gridded && !frame.skipped())
       occupancy.add_scan(frame.estimate.T_map_base, scan_rays(frame.scan, config.scan.camera));
     if (tf)
@@ -220,7 +231,8 @@ int run_service(const std::string &config_file) {
     if (frame.map) counts.map_points.store(frame.map->size(), std::memory_order_relaxed);
     last_frame = frame_record(frame);
     if (frame.state_due && snapshots)
-      snapshots->submit(make_snapshot(*last_frame, *frame.map, frame.map_integrations, n, config_hash));
+      snapshots->submit(
+          make_snapshot(*last_frame, *frame.map, frame.map_integrations, n, config_hash, occupancy.image()));
     if (!service.output_dir.empty()) run.frames.push_back(*last_frame);
   };
   sinks.profile = [&](const pipeline::ProfileSnapshot &profile) {
@@ -245,7 +257,12 @@ int run_service(const std::string &config_file) {
     pipeline.resume(resumed->points, resumed->map_integrations, resumed->T_map_base, resumed->covariance,
                     resumed->T_odom_base);
   }
-  pipeline.start(checked_source(input.source, config.scan.camera, status));
+  const auto initial_pose_counts = std::make_shared<InitialPoseCounts>();
+  pipeline::FrameSource source = checked_source(input.source, config.scan.camera, status);
+  if (initial_pose)
+    source =
+        with_initial_pose(std::move(source), initial_pose, service.dds.tf.map_frame, initial_pose_counts);
+  pipeline.start(std::move(source));
   if (!search_start) {
     status.state = dds::ServiceState::kRunning;
     status.stamp_s = system_time_s();
@@ -271,19 +288,21 @@ int run_service(const std::string &config_file) {
   status.frames_out = pipeline.frames_out();
   status.frames_dropped = pipeline.frames_dropped();
   status.last_error = pipeline.error();
+  if (status.last_error.empty()) status.last_error = initial_pose_counts->last_error();
   status.state = pipeline.error().empty() ? dds::ServiceState::kStopped : dds::ServiceState::kFailed;
   const double last_stamp = last_frame ? last_frame->t_s : status.stamp_s;
+  const grid::GridImage final_grid = occupancy.image();  // empty when nothing was gridded
   if (snapshots && last_frame) {
     // The final state, written before anything else can fail.
     snapshots->submit(make_snapshot(*last_frame, pipeline.slam().map().points(),
-                                    pipeline.slam().map().integrations(), counts.totals, config_hash));
+                                    pipeline.slam().map().integrations(), counts.totals, config_hash,
+                                    final_grid));
   }
   if (snapshots) {
     snapshots->finish();
     if (!snapshots->last_error().empty()) status.last_error = snapshots->last_error();
     spdlog::info("{} snapshots written to {}", snapshots->written(), snapshots->file().string());
   }
-  const grid::GridImage final_grid = occupancy.image();  // empty when nothing was gridded
   if (publisher) {
     if (posed) publisher->map(last_stamp, pipeline.slam().map().points());  // the final state
     if (final_grid.width > 0) publisher->grid(last_stamp, final_grid);
@@ -298,6 +317,11 @@ int run_service(const std::string &config_file) {
     OutputWriter(service.output_dir).write_all(run, pipeline.slam().map(), info);
     if (final_grid.width > 0)
       io::write_nav2_map(std::filesystem::path(service.output_dir) / "map.yaml", final_grid);
+  }
+  if (initial_pose) {
+    spdlog::info("{} initial poses on {} applied, {} in another frame ignored, {} non-finite dropped",
+                 initial_pose_counts->applied.load(), service.dds.initial_pose_topic,
+                 initial_pose_counts->rejected.load(), initial_pose->rejected());
   }
   if (odometry && odometry->rejected() > 0)
     spdlog::warn("{} odometry samples on {} had a non-finite stamp or pose and were dropped",

@@ -1,8 +1,11 @@
 #include "service_input.hpp"
 
+#include <spdlog/spdlog.h>
+
 #include <algorithm>
 #include <chrono>
 #include <filesystem>
+#include <numbers>
 #include <opencv2/imgproc.hpp>
 #include <opencv2/videoio.hpp>
 #include <stdexcept>
@@ -13,6 +16,7 @@
 #include "omnislam/io/ground_truth_files.hpp"
 #include "omnislam/io/image_file.hpp"
 #include "omnislam/io/poses.hpp"
+#include "omnislam/slam/planar_pose.hpp"
 
 namespace omnislam::app {
 namespace {
@@ -114,6 +118,30 @@ ServiceInput make_service_input(io::Config &config, std::shared_ptr<dds::Odometr
         input.source == "camera" ? "camera " + std::to_string(input.device) : "video " + input.path;
   }
   return result;
+}
+
+pipeline::FrameSource with_initial_pose(pipeline::FrameSource source,
+                                        std::shared_ptr<dds::InitialPoseReader> reader, std::string map_frame,
+                                        std::shared_ptr<InitialPoseCounts> counts) {
+  return [source = std::move(source), reader, map_frame, counts]() -> pipeline::FramePtr {
+    pipeline::FramePtr frame = source();
+    if (!frame) return frame;
+    for (const dds::InitialPose &pose : reader->poll()) {
+      if (pose.frame_id != map_frame) {
+        const std::string reason = "initial pose ignored: frame_id '" + pose.frame_id + "', expected '" +
+                                   map_frame + "' (dds.tf.map_frame)";
+        spdlog::warn("{}", reason);
+        counts->reject(reason);
+        continue;
+      }
+      frame->pose_reset = pipeline::Frame::PoseReset{pose.T_map_base, pose.covariance};  // the newest wins
+      counts->applied.fetch_add(1, std::memory_order_relaxed);
+      spdlog::info("initial pose: x {:.3f} m, y {:.3f} m, yaw {:.2f} deg in {}, from the frame at t {:.3f} s",
+                   pose.T_map_base.translation().x(), pose.T_map_base.translation().y(),
+                   slam::yaw_rad_of(pose.T_map_base) * 180.0 / std::numbers::pi, map_frame, frame->stamp_s);
+    }
+    return frame;
+  };
 }
 
 }  // namespace omnislam::app

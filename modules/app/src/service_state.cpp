@@ -54,7 +54,8 @@ std::optional<io::Snapshot> resume_state(const io::Config &config, const std::fi
 }
 
 io::Snapshot make_snapshot(const FrameRecord &frame, std::vector<slam::MapPoint> points, int map_integrations,
-                           const io::SnapshotCounters &counters, std::uint64_t config_hash) {
+                           const io::SnapshotCounters &counters, std::uint64_t config_hash,
+                           grid::GridImage grid) {
   io::Snapshot s;
   s.config_hash = config_hash;
   s.t_s = frame.t_s;
@@ -64,6 +65,7 @@ io::Snapshot make_snapshot(const FrameRecord &frame, std::vector<slam::MapPoint>
   s.counters = counters;
   s.map_integrations = map_integrations;
   s.points = std::move(points);
+  if (grid.width > 0) s.grid = std::move(grid);
   return s;
 }
 

@@ -33,9 +33,9 @@ class StateError : public std::runtime_error {
                                                        std::uint64_t config_hash);
 
 /// The snapshot after `frame`: its pose, covariance and odometry, with the map as it was
-/// then (points and slam::PointMap::integrations()).
+/// then (points and slam::PointMap::integrations()) and the occupancy grid (none when empty).
 [[nodiscard]] io::Snapshot make_snapshot(const FrameRecord &frame, std::vector<slam::MapPoint> points,
                                          int map_integrations, const io::SnapshotCounters &counters,
-                                         std::uint64_t config_hash);
+                                         std::uint64_t config_hash, grid::GridImage grid);
 
 }  // namespace omnislam::app

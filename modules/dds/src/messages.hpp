@@ -74,5 +74,7 @@ inline constexpr TopicQos kTfQos{true, Durability::kVolatile, 100};
 /// rt/odom is read best effort: a best-effort reader matches reliable writers and the
 /// sensor-data QoS (best effort) that base drivers use; a reliable one matches only the former.
 inline constexpr TopicQos kOdomQos{false, Durability::kVolatile, 50};
+/// rt/initialpose as RViz writes it (ROS 2 defaults: reliable, volatile).
+inline constexpr TopicQos kInitialPoseQos{true, Durability::kVolatile, 10};
 
 }  // namespace omnislam::dds::detail

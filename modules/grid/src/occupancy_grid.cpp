@@ -74,6 +74,19 @@ void OccupancyGrid::add_scan(const Eigen::Isometry2d &T_map_base, std::span<cons
   }
 }
 
+void OccupancyGrid::seed(const GridImage &start) {
+  const Eigen::Vector2i low = (start.origin_m / config_.resolution_m).array().round().cast<int>();
+  for (int y = 0; y < start.height; ++y) {
+    for (int x = 0; x < start.width; ++x) {
+      const std::int8_t cell =
+          start.cells[static_cast<std::size_t>(y) * static_cast<std::size_t>(start.width) +
+                      static_cast<std::size_t>(x)];
+      // Unknown cells too (at even odds): the grid keeps the extent it had.
+      log_odds_[key(low + Cell(x, y))] = cell == 100 ? max_ : (cell == 0 ? min_ : 0.0f);
+    }
+  }
+}
+
 GridImage OccupancyGrid::image() const {
   GridImage image;
   image.resolution_m = config_.resolution_m;

@@ -61,6 +61,7 @@ void read_dds(YamlSection &section, DdsSectionConfig &dds) {
   section.read("config", dds.config);
   section.read("wait_for_subscribers", dds.wait_for_subscribers);
   section.read("wait_timeout_s", dds.wait_timeout_s);
+  section.read("initial_pose_topic", dds.initial_pose_topic);
   if (dds.domain_id < 0 || dds.domain_id > 232) section.fail("domain_id", "must be in 0..232");
   read_section(section, "tf", [&](YamlSection &tf) {
     tf.read("enabled", dds.tf.enabled);

@@ -13,6 +13,7 @@
 #include <fstream>
 #include <iterator>
 #include <limits>
+#include <optional>
 #include <string_view>
 #include <system_error>
 
@@ -24,6 +25,7 @@ constexpr std::size_t kHeaderBytes = 24;           // magic, version, payload si
 constexpr std::size_t kOdometryBytes = 8 + 3 * 8;  // version 2 only
 constexpr std::size_t kFixedPayloadBytesV1 = 8 + 8 * 4 + 8 * 9 + 8 * 5 + 8 + 8;
 constexpr std::size_t kPointBytes = 8 + 8 + 4 + 4;
+constexpr std::size_t kGridHeaderBytes = 4 + 4 + 8 + 8 + 8;  // version 3, when has_grid is 1
 
 class ByteWriter {
  public:
@@ -32,6 +34,7 @@ class ByteWriter {
   void i32(std::int32_t v) { u32(static_cast<std::uint32_t>(v)); }
   void i64(std::int64_t v) { u64(static_cast<std::uint64_t>(v)); }
   void f64(double v) { u64(std::bit_cast<std::uint64_t>(v)); }
+  void i8(std::int8_t v) { bytes.push_back(static_cast<std::uint8_t>(v)); }
   std::vector<std::uint8_t> bytes;
 
  private:
@@ -49,6 +52,8 @@ class ByteReader {
   std::uint64_t u64() { return little_endian(8); }
   std::int32_t i32() { return static_cast<std::int32_t>(u32()); }
   std::int64_t i64() { return static_cast<std::int64_t>(u64()); }
+  std::int8_t i8() { return static_cast<std::int8_t>(little_endian(1)); }
+  [[nodiscard]] std::size_t remaining() const { return bytes_.size() - offset_; }
   double f64(const char *field) {
     const double v = std::bit_cast<double>(u64());
     if (!std::isfinite(v)) throw SnapshotError(name_ + ": " + field + " is not a finite number");
@@ -101,6 +106,38 @@ void fsync_directory(const std::filesystem::path &dir) {
   if (status != 0) throw std::runtime_error(system_error("fsync directory", dir));
 }
 
+// The version-3 grid section: u64 has_grid, then (when 1) the trinary grid.
+std::optional<grid::GridImage> decode_grid(ByteReader &in, const std::string &name) {
+  const std::uint64_t has_grid = in.u64();
+  if (has_grid > 1) throw SnapshotError(name + ": has_grid is " + std::to_string(has_grid));
+  if (has_grid == 0) return std::nullopt;
+  if (in.remaining() < kGridHeaderBytes) throw SnapshotError(name + ": truncated occupancy grid");
+  grid::GridImage g;
+  g.width = in.i32();
+  g.height = in.i32();
+  g.resolution_m = in.f64("grid resolution_m");
+  g.origin_m.x() = in.f64("grid origin x_m");
+  g.origin_m.y() = in.f64("grid origin y_m");
+  if (g.width <= 0 || g.height <= 0 || !(g.resolution_m > 0.0)) {
+    throw SnapshotError(name + ": occupancy grid of " + std::to_string(g.width) + " x " +
+                        std::to_string(g.height) + " cells at " + std::to_string(g.resolution_m) + " m");
+  }
+  const std::uint64_t cells = static_cast<std::uint64_t>(g.width) * static_cast<std::uint64_t>(g.height);
+  if (in.remaining() != cells) {
+    throw SnapshotError(name + ": the occupancy grid announces " + std::to_string(cells) +
+                        " cells, the file holds " + std::to_string(in.remaining()) + " bytes");
+  }
+  g.cells.resize(cells);
+  for (std::uint64_t i = 0; i < cells; ++i) {
+    g.cells[i] = in.i8();
+    if (g.cells[i] != -1 && g.cells[i] != 0 && g.cells[i] != 100) {
+      throw SnapshotError(name + ": occupancy grid cell " + std::to_string(i) + " is " +
+                          std::to_string(g.cells[i]) + " (not -1, 0 or 100)");
+    }
+  }
+  return g;
+}
+
 }  // namespace
 
 std::vector<std::uint8_t> encode_snapshot(const Snapshot &snapshot) {
@@ -128,6 +165,16 @@ std::vector<std::uint8_t> encode_snapshot(const Snapshot &snapshot) {
     payload.f64(p.position_m.y());
     payload.i32(p.hits);
     payload.i32(p.first_seen);
+  }
+  payload.u64(snapshot.grid ? 1 : 0);
+  if (snapshot.grid) {
+    const grid::GridImage &g = *snapshot.grid;
+    payload.i32(g.width);
+    payload.i32(g.height);
+    payload.f64(g.resolution_m);
+    payload.f64(g.origin_m.x());
+    payload.f64(g.origin_m.y());
+    for (const std::int8_t cell : g.cells) payload.i8(cell);
   }
 
   ByteWriter header;
@@ -192,10 +239,14 @@ Snapshot decode_snapshot(std::span<const std::uint8_t> bytes, const std::string 
     if (has_odometry == 1) s.T_odom_base = slam::planar_pose(ox, oy, oyaw);
   }
   const std::uint64_t count = in.u64();
+  // Version 3 ends with the grid section (at least its u64 has_grid); earlier ones with the points.
   const std::uint64_t point_bytes = payload.size() - fixed_bytes;
-  if (point_bytes % kPointBytes != 0 || point_bytes / kPointBytes != count) {
+  const std::uint64_t announced = count <= point_bytes / kPointBytes ? count * kPointBytes : point_bytes + 1;
+  const bool points_fit = version >= 3 ? announced + 8 <= point_bytes
+                                       : point_bytes % kPointBytes == 0 && announced == point_bytes;
+  if (!points_fit) {
     throw SnapshotError(name + ": announces " + std::to_string(count) + " map points but holds " +
-                        std::to_string(point_bytes) + " bytes of points");
+                        std::to_string(point_bytes) + " bytes of points" + (version >= 3 ? " and grid" : ""));
   }
   s.points.reserve(count);
   for (std::uint64_t i = 0; i < count; ++i) {
@@ -211,6 +262,8 @@ Snapshot decode_snapshot(std::span<const std::uint8_t> bytes, const std::string 
     }
     s.points.push_back(p);
   }
+  if (version >= 3) s.grid = decode_grid(in, name);
+  if (in.remaining() != 0) throw SnapshotError(name + ": trailing bytes after the occupancy grid");
   return s;
 }
 

@@ -1,5 +1,8 @@
 #include "omnislam/pipeline/pipeline.hpp"
 
+#include <Eigen/Eigenvalues>
+#include <cmath>
+
 #include <exception>
 #include <utility>
 
@@ -68,6 +71,7 @@ void Pipeline::relocalize(std::vector<slam::MapPoint> points, int integrations,
   positions.reserve(points.size());
   for (const slam::MapPoint &p : points) positions.push_back(p.position_m);
   relocalizer_ = std::make_unique<slam::Relocalizer>(positions, config);
+  relocalizer_config_ = config;
   saved_points_ = std::move(points);
   saved_integrations_ = integrations;
   window_ = window;
@@ -146,6 +150,7 @@ void Pipeline::capture_loop(FrameSource source) {
   const Clock::time_point start = Clock::now();
   std::uint64_t sequence = 0;
   std::uint32_t dropped_run = 0;
+  std::optional<Frame::PoseReset> carried_reset;
   while (!stop_.load(std::memory_order_relaxed)) {
     if (config_.input_rate_hz > 0.0) {
       const auto due = start + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(
@@ -170,10 +175,13 @@ void Pipeline::capture_loop(FrameSource source) {
     frame->sequence = ++sequence;
     frame->timings.stage_ms[kRead] = ms_between(before, frame->captured);
     frame->dropped_before = dropped_run;
+    if (!frame->pose_reset) frame->pose_reset = std::move(carried_reset);  // a dropped frame's
+    carried_reset.reset();
     frame->enqueued = frame->captured;
     captured_.fetch_add(1, std::memory_order_relaxed);
     if (config_.mode == Mode::kLive) {
       if (!out.try_push(frame)) {
+        carried_reset = std::move(frame->pose_reset);
         ++dropped_run;
         dropped_.fetch_add(1, std::memory_order_relaxed);
         continue;
@@ -234,6 +242,18 @@ void Pipeline::stereo_loop() {
   queues_[kSlamQueue].close();
 }
 
+void Pipeline::narrow_search(const Frame::PoseReset &rough, const std::optional<Eigen::Isometry2d> &T_odom_base) {
+  // Three standard deviations of the rough pose, never less than what the relocaliser takes
+  // for one and the same pose.
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> position(rough.covariance.topLeftCorner<2, 2>());
+  const double sigma_m = std::sqrt(std::max(0.0, position.eigenvalues().maxCoeff()));
+  const double sigma_rad = std::sqrt(std::max(0.0, rough.covariance(2, 2)));
+  window_ = slam::SearchWindow{rough.T_map_base, std::max(3.0 * sigma_m, relocalizer_config_.distinct_m),
+                               std::max(3.0 * sigma_rad, relocalizer_config_.distinct_rad)};
+  window_odometry_ = T_odom_base;
+  relocalizer_->reset();
+}
+
 void Pipeline::relocalize_frame(Frame &frame, const std::optional<Eigen::Isometry2d> &T_odom_base) {
   // The window travels with the robot: its centre follows the odometry since the last frame.
   if (window_ && T_odom_base && window_odometry_) {
@@ -259,8 +279,11 @@ void Pipeline::slam_loop() {
     StepClock clock(*frame);
     const auto odometry = frame->has_odometry ? std::optional(frame->T_odom_base) : std::nullopt;
     if (relocalizer_) {
+      // An operator's pose while the pose is searched for: a search window, not the answer.
+      if (frame->pose_reset) narrow_search(*frame->pose_reset, odometry);
       relocalize_frame(*frame, odometry);
     } else {
+      if (frame->pose_reset) slam_.set_pose(frame->pose_reset->T_map_base, frame->pose_reset->covariance);
       frame->estimate = slam_.process(scan_points(frame->scan), odometry);
     }
     clock.lap(kSlam);

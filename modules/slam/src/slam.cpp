@@ -116,6 +116,19 @@ void Slam::resume(std::vector<MapPoint> points, int integrations, const Eigen::I
   previous_failed_ = false;
 }
 
+void Slam::set_pose(const Eigen::Isometry2d &T_map_base, const Eigen::Matrix3d &covariance) {
+  // The odometry chain restarts at the next frame: no motion is predicted from before the jump.
+  anchor_T_odom_base_.reset();
+  anchor_T_map_base_ = T_map_base;
+  previous_.T_map_base = T_map_base;
+  previous_.covariance = covariance;
+  last_step_ = Eigen::Isometry2d::Identity();
+  // The scans before the jump sit at the old poses: the whole map stands in for them.
+  if (!map_.empty()) recent_scans_map_.assign(1, map_.index().points());
+  relaxation_percent_ = 0.0;
+  previous_failed_ = false;
+}
+
 void Slam::set_anchor(const Eigen::Isometry2d &T_odom_base, const Eigen::Isometry2d &T_map_base) {
   anchor_T_odom_base_ = T_odom_base;
   anchor_T_map_base_ = T_map_base;

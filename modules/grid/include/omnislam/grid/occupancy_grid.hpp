@@ -51,6 +51,12 @@ class OccupancyGrid {
   /// Adds one scan taken at `T_map_base`.
   void add_scan(const Eigen::Isometry2d &T_map_base, std::span<const Ray> rays);
 
+  /// Starts from a trinary grid (a resumed snapshot's): its occupied cells at the
+  /// max_probability bound, its free cells at min_probability, its unknown cells at even
+  /// odds, so that image() gives it back (extent included) until new scans change it. Cells are matched by
+  /// position; `start` should have this grid's resolution.
+  void seed(const GridImage &start);
+
   /// The trinary grid over every cell observed so far (empty when none is).
   [[nodiscard]] GridImage image() const;
 

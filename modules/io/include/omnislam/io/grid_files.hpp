@@ -18,4 +18,12 @@ namespace omnislam::io {
 /// Throws std::runtime_error naming the file that cannot be written or an empty grid.
 void write_nav2_map(const std::filesystem::path &yaml_file, const grid::GridImage &image);
 
+/// Reads a map as nav2_map_server loads it in trinary mode: each pixel's shade v (0..255)
+/// gives p = (255 - v) / 255, or v / 255 with negate 1; p > occupied_thresh is occupied
+/// (100), p < free_thresh free (0), anything else unknown (-1). The image path is relative
+/// to the YAML file's folder; the image's top row is the grid's highest y.
+/// Throws std::runtime_error naming the file and the key or problem (missing key, a mode
+/// other than trinary, an unreadable image).
+[[nodiscard]] grid::GridImage read_nav2_map(const std::filesystem::path &yaml_file);
+
 }  // namespace omnislam::io

@@ -11,7 +11,7 @@
 ///            odometry: dataset | dds | none, odometry_topic, odometry_max_extrapolation_s,
 ///            odometry_max_gap_s}
 /// pipeline: {mode: live | replay, queue_capacity, map_rate_hz, profile_period_s, profile_window}
-/// dds:      {enabled, domain_id, config, wait_for_subscribers, wait_timeout_s,
+/// dds:      {enabled, domain_id, config, wait_for_subscribers, wait_timeout_s, initial_pose_topic,
 ///            tf: {enabled, map_frame, odom_frame, base_frame, publish_odom_to_base,
 ///                 rate_hz, future_dating_s}}
 /// service:  {output_dir, stage_timeout_s}
@@ -55,6 +55,9 @@ struct DdsSectionConfig {
   std::string config;            ///< Cyclone XML file; empty: CYCLONEDDS_URI or Cyclone's default
   int wait_for_subscribers = 0;  ///< before starting, wait for this many pose readers ...
   double wait_timeout_s = 10.0;  ///< ... at most this long (then start anyway, with a warning)
+  /// geometry_msgs/PoseWithCovarianceStamped in tf.map_frame (RViz's "2D Pose Estimate"):
+  /// sets the SLAM pose for the next frame, the map kept. Empty: not subscribed.
+  std::string initial_pose_topic = "rt/initialpose";
   /// rt/tf (tf2_msgs/TFMessage), REP-105: map -> odom from each frame's map pose and its
   /// odometry pose, re-sent at rate_hz between frames, stamped future_dating_s ahead (as
   /// slam_toolbox's transform_timeout) so that TF users can look up the data's time.

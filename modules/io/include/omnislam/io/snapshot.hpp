@@ -9,30 +9,35 @@
 #include <string>
 #include <vector>
 
+#include "omnislam/grid/occupancy_grid.hpp"
 #include "omnislam/slam/point_map.hpp"
 
 /// @file
 /// Snapshots of the SLAM state (map, pose, counters, configuration hash) that a service
 /// writes periodically into its state directory and resumes from after a restart.
 ///
-/// File format, version 2 (all integers and doubles little-endian):
+/// File format, version 3 (all integers and doubles little-endian):
 /// ```
 /// offset  size  field
 ///  0       8    magic "OMNISNAP"
-///  8       4    u32 format version (1)
+///  8       4    u32 format version (3)
 /// 12       8    u64 payload size in bytes
 /// 20       4    u32 CRC-32 (zlib) of bytes 8..19 followed by the payload
 /// 24       -    payload: u64 config_hash, f64 t_s, f64 x_m, f64 y_m, f64 yaw_rad,
 ///               9 x f64 covariance (row-major, x y yaw), u64 frames, u64 integrated,
 ///               u64 not_integrated, u64 skipped, u64 dropped, i64 map_integrations,
 ///               u64 has_odometry (0 or 1), f64 odom x_m, f64 odom y_m, f64 odom yaw_rad,
-///               u64 point count, then per point f64 x_m, f64 y_m, i32 hits, i32 first_seen
+///               u64 point count, then per point f64 x_m, f64 y_m, i32 hits, i32 first_seen,
+///               u64 has_grid (0 or 1), and when 1: i32 width, i32 height, f64 resolution_m,
+///               f64 origin x_m, f64 origin y_m, width x height i8 cells (-1, 0, 100; the
+///               layout of grid::GridImage)
 /// ```
-/// Version 1 is version 2 without the four odometry fields; it is still read.
+/// Version 2 is version 3 without the grid section, version 1 version 2 without the four
+/// odometry fields; both are still read (their `grid` is empty).
 
 namespace omnislam::io {
 
-inline constexpr std::uint32_t kSnapshotVersion = 2;
+inline constexpr std::uint32_t kSnapshotVersion = 3;
 
 /// A snapshot that cannot be used: missing, truncated, of another version, failing its
 /// checksum, or holding impossible values. The message names the file.
@@ -62,6 +67,9 @@ struct Snapshot {
   SnapshotCounters counters;
   int map_integrations = 0;  ///< slam::PointMap::integrations() (the age reference of first_seen)
   std::vector<slam::MapPoint> points;
+  /// The trinary occupancy grid (free space included) of the same state, when the writer
+  /// had one (version 3); a resumed service does not rebuild its log-odds from it.
+  std::optional<grid::GridImage> grid;
 };
 
 /// The bytes of the file format above.

@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <memory>
 #include <opencv2/core.hpp>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -50,6 +51,14 @@ struct Frame {
   /// Frames dropped by capture just before this one (live mode). Their motion is not
   /// lost: odometry is an absolute pose, so this frame's pose composes all of it.
   std::uint32_t dropped_before = 0;
+
+  /// An operator's pose (rt/initialpose) to apply before this frame (slam::Slam::set_pose).
+  /// Capture carries it over to the next frame when this one is dropped.
+  struct PoseReset {
+    Eigen::Isometry2d T_map_base = Eigen::Isometry2d::Identity();
+    Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
+  };
+  std::optional<PoseReset> pose_reset;
 
   cv::Mat image;      ///< CV_8UC1 of the camera size; released after the front-end
   std::string error;  ///< non-empty: the image was unusable and the frame is skipped

@@ -117,6 +117,9 @@ class Pipeline {
   /// One frame through the relocaliser; on the frame that confirms a pose, hands the saved
   /// map and that pose to slam_.
   void relocalize_frame(Frame &frame, const std::optional<Eigen::Isometry2d> &T_odom_base);
+  /// An operator's rough pose (rt/initialpose) while relocalising: the search restarts inside
+  /// the window its covariance spans.
+  void narrow_search(const Frame::PoseReset &rough, const std::optional<Eigen::Isometry2d> &T_odom_base);
   void publish_loop();
   [[nodiscard]] bool take(Queue &queue, std::size_t index, FramePtr &frame);
   void forward(Queue &queue, FramePtr &frame);
@@ -131,6 +134,7 @@ class Pipeline {
   slam::Slam slam_;
   /// While relocalising: the search, the saved map it hands to slam_, and the search window.
   std::unique_ptr<slam::Relocalizer> relocalizer_;
+  slam::RelocalizerConfig relocalizer_config_;
   std::vector<slam::MapPoint> saved_points_;
   int saved_integrations_ = 0;
   std::optional<slam::SearchWindow> window_;

@@ -96,6 +96,12 @@ class Slam {
   void resume(std::vector<MapPoint> points, int integrations, const Eigen::Isometry2d &T_map_base,
               const Eigen::Matrix3d &covariance, const std::optional<Eigen::Isometry2d> &T_odom_base = {});
 
+  /// An operator's pose (rt/initialpose): the next frame is predicted at `T_map_base`
+  /// (the robot taken not to have moved since) and registered against the whole map, which
+  /// is kept. Before the first frame it places the new map's first scan there instead of at
+  /// the origin.
+  void set_pose(const Eigen::Isometry2d &T_map_base, const Eigen::Matrix3d &covariance);
+
   [[nodiscard]] const PointMap &map() const { return map_; }
 
  private:
