@@ -15,6 +15,8 @@ namespace omnislam::app {
   record.covariance = frame.estimate.covariance;
   record.skipped = frame.skipped();
   record.integrated = frame.estimate.integrated;
+  record.keyframe = frame.estimate.keyframe;
+  record.loop_closed = frame.estimate.loop_closed;
   record.attempt = frame.estimate.attempt;
   record.srel_percent = frame.estimate.registration.srel_percent;
   record.iterations = frame.estimate.registration.iterations;

@@ -98,7 +98,7 @@ void run_replay(const ReplayOptions &options, std::optional<std::uint64_t> degra
   pipeline::Pipeline pipeline(config.scan, config.slam, pipeline_config, std::move(sinks));
   pipeline.run(dataset_source(info, odometry, config.scan.camera, std::move(source_options)));
   if (!pipeline.error().empty()) throw std::runtime_error(pipeline.error());
-  writer.write_all(run, pipeline.slam().map(), info);
+  writer.write_all(run, pipeline.slam().map(), info, pipeline.slam().trajectory());
   const grid::GridImage grid_image = occupancy.image();
   if (grid_image.width > 0)
     io::write_nav2_map(std::filesystem::path(options.out_dir) / "map.yaml", grid_image);

@@ -24,6 +24,8 @@ struct FrameRecord {
   Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
   bool skipped = false;  ///< the image could not be used
   bool integrated = false;
+  bool keyframe = false;     ///< became a keyframe of the pose graph
+  bool loop_closed = false;  ///< a loop closure corrected the graph at this frame
   slam::Attempt attempt = slam::Attempt::kNone;
   double srel_percent = 0.0;
   int iterations = 0;
