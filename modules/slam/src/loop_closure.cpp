@@ -42,6 +42,22 @@ class ScoreGrid {
     }
   }
 
+  /// The grid whose cell (x, y) holds the largest value of this one's cells x..x+block-1,
+  /// y..y+block-1: summed over a scan's points it bounds the score of every pose whose
+  /// offset lies in that block of cells (Olson 2009's multi-resolution bound).
+  [[nodiscard]] ScoreGrid pooled(int block) const {
+    ScoreGrid out = *this;
+    for (int y = 0; y < height_; ++y) {
+      for (int x = 0; x < width_; ++x) {
+        float value = 0.0f;
+        for (int dy = 0; dy < block && y + dy < height_; ++dy)
+          for (int dx = 0; dx < block && x + dx < width_; ++dx) value = std::max(value, values_[index(x + dx, y + dy)]);
+        out.values_[index(x, y)] = value;
+      }
+    }
+    return out;
+  }
+
   /// The cell of a point (may lie outside the grid).
   [[nodiscard]] Eigen::Vector2i cell_of(const Point2 &p) const {
     return {cell(p.x() - origin_.x()), cell(p.y() - origin_.y())};
@@ -134,19 +150,48 @@ LoopMatch match_keyframes(const Points2 &candidate_scans, const Points2 &current
   const int side = 2 * xy_steps + 1;
   // Scores indexed [yaw][y][x]; per yaw the points' cells are found once, and a shift of
   // the pose by whole cells is a shift of those indices.
-  std::vector<float> scores(static_cast<std::size_t>((2 * yaw_steps + 1) * side * side));
-  std::vector<Eigen::Vector2i> cells(sample.size());
+  // Branch and bound over blocks of kBlock x kBlock offsets: a block's bound (the pooled
+  // grid) is computed for every yaw, and its poses are scored only while the bound could
+  // still beat the best score found or reach ambiguity_ratio of it. A pose never scored
+  // (-1) is thus below both, and cannot change the best pose or the ambiguity test.
+  constexpr int kBlock = 4;
+  const ScoreGrid bound_grid = grid.pooled(kBlock);
+  const int blocks = (side + kBlock - 1) / kBlock;
+  std::vector<float> scores(static_cast<std::size_t>((2 * yaw_steps + 1) * side * side), -1.0f);
+  std::vector<std::vector<Eigen::Vector2i>> cells(static_cast<std::size_t>(2 * yaw_steps + 1));
   auto at = [&](int a, int iy, int ix) -> float & {
     return scores[static_cast<std::size_t>(((a + yaw_steps) * side + iy + xy_steps) * side + ix + xy_steps)];
   };
+  struct Block {
+    float bound;
+    int a, by, bx;
+  };
+  std::vector<Block> bounds;
+  const double n = static_cast<double>(sample.size());
   for (int a = -yaw_steps; a <= yaw_steps; ++a) {
     const Eigen::Rotation2Dd R(guess_yaw + a * yaw_step);
-    for (std::size_t i = 0; i < sample.size(); ++i) cells[i] = grid.cell_of(R * sample[i] + guess.translation());
-    for (int iy = -xy_steps; iy <= xy_steps; ++iy) {
-      for (int ix = -xy_steps; ix <= xy_steps; ++ix) {
+    std::vector<Eigen::Vector2i> &turned = cells[static_cast<std::size_t>(a + yaw_steps)];
+    for (const Point2 &p : sample) turned.push_back(grid.cell_of(R * p + guess.translation()));
+    for (int by = 0; by < blocks; ++by) {
+      for (int bx = 0; bx < blocks; ++bx) {
         double sum = 0.0;
-        for (const Eigen::Vector2i &c : cells) sum += grid.at(c.x() + ix, c.y() + iy);
-        at(a, iy, ix) = static_cast<float>(sum / static_cast<double>(sample.size()));
+        for (const Eigen::Vector2i &c : turned)
+          sum += bound_grid.at(c.x() - xy_steps + bx * kBlock, c.y() - xy_steps + by * kBlock);
+        bounds.push_back({static_cast<float>(sum / n), a, by, bx});
+      }
+    }
+  }
+  std::sort(bounds.begin(), bounds.end(), [](const Block &l, const Block &r) { return l.bound > r.bound; });
+  double best_so_far = 0.0;
+  for (const Block &b : bounds) {
+    if (b.bound < config.ambiguity_ratio * best_so_far) break;
+    const std::vector<Eigen::Vector2i> &turned = cells[static_cast<std::size_t>(b.a + yaw_steps)];
+    for (int iy = -xy_steps + b.by * kBlock; iy < -xy_steps + (b.by + 1) * kBlock && iy <= xy_steps; ++iy) {
+      for (int ix = -xy_steps + b.bx * kBlock; ix < -xy_steps + (b.bx + 1) * kBlock && ix <= xy_steps; ++ix) {
+        double sum = 0.0;
+        for (const Eigen::Vector2i &c : turned) sum += grid.at(c.x() + ix, c.y() + iy);
+        at(b.a, iy, ix) = static_cast<float>(sum / n);
+        best_so_far = std::max(best_so_far, sum / n);
       }
     }
   }
