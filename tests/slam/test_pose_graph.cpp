@@ -132,3 +132,24 @@ TEST_CASE("pose graph: fewer than two nodes is a no-op") {
   CHECK(graph.optimize().converged);
   CHECK((graph.pose(0).translation() - Eigen::Vector2d(1.0, 2.0)).norm() < 1e-12);
 }
+
+TEST_CASE("pose graph: three injected false loop edges are all rejected and move the result by less than 10 mm") {
+  DriftedSquare reference(5), attacked(5);
+  const PoseGraphEdge true_loop{0, reference.last(), Eigen::Isometry2d::Identity(), information(0.005, 0.2 * kDeg),
+                                true};
+  reference.graph.add_edge(true_loop);
+  attacked.graph.add_edge(true_loop);
+  // Confident, mutually inconsistent claims: opposite corners seen as neighbours, a side
+  // mistaken for its parallel one, and a node matched one metre along its own side.
+  attacked.graph.add_edge({8, 24, planar_pose(0.3, 0.1, 10.0 * kDeg), information(0.005, 0.2 * kDeg), true});
+  attacked.graph.add_edge({4, 20, planar_pose(0.0, 0.0, 180.0 * kDeg), information(0.005, 0.2 * kDeg), true});
+  attacked.graph.add_edge({12, 14, planar_pose(0.0, 0.0, 0.0), information(0.005, 0.2 * kDeg), true});
+  reference.graph.optimize();
+  const PoseGraphResult result = attacked.graph.optimize();
+  CHECK(result.rejected_loops == 3);
+  double moved_m = 0.0;
+  for (int i = 0; i < reference.graph.size(); ++i)
+    moved_m = std::max(moved_m, (attacked.graph.pose(i).translation() - reference.graph.pose(i).translation()).norm());
+  CHECK(moved_m < 0.010);
+  CHECK(std::abs(attacked.max_error_m() - reference.max_error_m()) < 0.010);
+}
