@@ -42,8 +42,11 @@ double quantile(std::vector<double> v, double q) {
 
 int main(int argc, char **argv) {
   int frames = 200;
-  for (int i = 1; i + 1 < argc; ++i)
-    if (std::string(argv[i]) == "--frames") frames = std::max(10, std::atoi(argv[i + 1]));
+  omnislam::slam::SlamConfig config;  // the defaults: loop closure on
+  for (int i = 1; i < argc; ++i) {
+    if (std::string(argv[i]) == "--frames" && i + 1 < argc) frames = std::max(10, std::atoi(argv[i + 1]));
+    if (std::string(argv[i]) == "--no-loop-closure") config.loop_closure.enabled = false;
+  }
   std::printf(
       "bench_map_size: %d frames per map, one thread; per-frame SLAM (registration + integration) in ms\n",
       frames);
@@ -52,7 +55,7 @@ int main(int argc, char **argv) {
     const std::vector<Segment> walls = omnislam::test::building(side);
     std::vector<MapPoint> points = sample(walls);
     const std::size_t size = points.size();
-    omnislam::slam::Slam slam;
+    omnislam::slam::Slam slam(config);
     const Eigen::Isometry2d start = omnislam::test::pose(2.5, 2.5, 0.0);
     slam.resume(std::move(points), 100, start, Eigen::Matrix3d::Identity() * 1e-4, start);
     std::mt19937_64 rng(1);

@@ -2,7 +2,7 @@
 // (images decoded beforehand, the dataset looped), then capture->pose latency with live
 // input at 30 Hz. Run it through scripts/bench-pipeline (2 cores).
 //
-//   bench_pipeline [DATASET] [--loops N] [--live-seconds S] [--rate HZ]
+//   bench_pipeline [DATASET] [--loops N] [--live-seconds S] [--rate HZ] [--no-loop-closure]
 
 #include <chrono>
 #include <cstdio>
@@ -60,6 +60,7 @@ int main(int argc, char **argv) {
   std::filesystem::path dataset = "datasets/sim-room-37";
   int loops = 20;
   double live_seconds = 10.0, rate_hz = 30.0;
+  slam::SlamConfig slam_config;  // the defaults: loop closure on
   for (int i = 1; i < argc; ++i) {
     const std::string arg = argv[i];
     if (arg == "--loops" && i + 1 < argc) {
@@ -68,6 +69,8 @@ int main(int argc, char **argv) {
       live_seconds = std::atof(argv[++i]);
     } else if (arg == "--rate" && i + 1 < argc) {
       rate_hz = std::atof(argv[++i]);
+    } else if (arg == "--no-loop-closure") {
+      slam_config.loop_closure.enabled = false;
     } else {
       dataset = arg;
     }
@@ -76,7 +79,7 @@ int main(int argc, char **argv) {
 
   {  // 1. Throughput: replay mode (blocking queues), input as fast as memory gives it.
     const std::size_t frames = data.images.size() * static_cast<std::size_t>(loops);
-    pipeline::Pipeline pipeline(data.scan, {}, {}, {});
+    pipeline::Pipeline pipeline(data.scan, slam_config, {}, {});
     const auto start = std::chrono::steady_clock::now();
     pipeline.run(looped(data, frames));
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -92,7 +95,7 @@ int main(int argc, char **argv) {
     pipeline::Sinks sinks;
     sinks.profile = [&](const pipeline::ProfileSnapshot &p) { profile = p; };
     const auto frames = static_cast<std::size_t>(live_seconds * rate_hz);
-    pipeline::Pipeline pipeline(data.scan, {}, config, sinks);
+    pipeline::Pipeline pipeline(data.scan, slam_config, config, sinks);
     pipeline.run(looped(data, frames));
     std::printf(
         "latency at %.0f Hz: %zu frames, capture->pose p50 %.2f ms, p99 %.2f ms, max %.2f ms; dropped %llu\n",

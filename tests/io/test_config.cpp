@@ -184,6 +184,38 @@ TEST_CASE("config: the slam section, and the bundled thesis preset", "[io][confi
       omnislam::io::load_config(OMNISLAM_SOURCE_DIR "/deploy/thesis-2008.yaml");
   CHECK(thesis.slam.use_srel_test);
   CHECK(thesis.slam.target == omnislam::slam::RegistrationTarget::kPreviousScan);
+  CHECK_FALSE(thesis.slam.loop_closure.enabled);  // the thesis has no pose graph
+}
+
+TEST_CASE("config: slam.loop_closure, with unknown keys and bad values naming key and line", "[io][config]") {
+  const omnislam::io::Config defaults;
+  CHECK(defaults.slam.loop_closure.enabled);
+  const omnislam::io::Config config = omnislam::io::load_config(
+      write_file("loops.yaml",
+                 "slam:\n  loop_closure:\n    enabled: false\n    keyframe_distance_m: 0.8\n"
+                 "    keyframe_angle_deg: 30\n    min_path_gap_m: 8\n    max_candidates: 2\n"
+                 "    drift_per_m: 0.05\n    max_window_deg: 6\n    min_overlap: 0.7\n"
+                 "    loop_chi2_limit: 16.27\n"));
+  const omnislam::slam::LoopClosureConfig &loops = config.slam.loop_closure;
+  CHECK_FALSE(loops.enabled);
+  CHECK(loops.keyframes.keyframe_distance_m == 0.8);
+  CHECK(loops.keyframes.keyframe_angle_rad == Approx(30.0 * 3.14159265358979 / 180.0));
+  CHECK(loops.min_path_gap_m == 8.0);
+  CHECK(loops.max_candidates == 2);
+  CHECK(loops.keyframes.drift_per_m == 0.05);
+  CHECK(loops.max_window_rad == Approx(6.0 * 3.14159265358979 / 180.0));
+  CHECK(loops.min_overlap == 0.7);
+  CHECK(loops.graph.loop_chi2_limit == 16.27);
+  CHECK(loops.ambiguity_ratio == defaults.slam.loop_closure.ambiguity_ratio);  // unset keys keep defaults
+  CHECK_THROWS_WITH(
+      omnislam::io::load_config(write_file("loops-unknown.yaml", "slam:\n  loop_closure:\n    enable: true\n")),
+      Catch::Contains("loops-unknown.yaml:3:") && Catch::Contains("unknown key 'slam.loop_closure.enable'"));
+  CHECK_THROWS_WITH(omnislam::io::load_config(
+                        write_file("loops-share.yaml", "slam:\n  loop_closure:\n    min_overlap: 1.5\n")),
+                    Catch::Contains("loops-share.yaml:3") && Catch::Contains("'slam.loop_closure.min_overlap'"));
+  CHECK_THROWS_WITH(omnislam::io::load_config(
+                        write_file("loops-count.yaml", "slam:\n  loop_closure:\n    max_candidates: 0\n")),
+                    Catch::Contains("max_candidates"));
 }
 
 TEST_CASE("config: the installed defaults (deploy/*.yaml) load", "[io][config]") {

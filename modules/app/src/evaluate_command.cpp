@@ -59,8 +59,20 @@ void evaluate(const std::filesystem::path &run_dir, const std::filesystem::path 
     frame_of.push_back(static_cast<int>(frame));
   }
   if (estimate.empty()) throw std::runtime_error((run_dir / "trajectory.tum").string() + ": no poses");
+  // The poses as they were published (a run with a pose graph; older runs have only
+  // trajectory.tum, which then is the online trajectory too): same frames, same order.
+  std::vector<Eigen::Isometry2d> online = estimate;
+  const bool has_online = std::filesystem::exists(run_dir / "trajectory_online.tum");
+  if (has_online) {
+    online = io::to_isometries(io::read_tum_file(run_dir / "trajectory_online.tum"));
+    if (online.size() != estimate.size()) {
+      throw std::runtime_error((run_dir / "trajectory_online.tum").string() + ": " + std::to_string(online.size()) +
+                               " poses for " + std::to_string(estimate.size()) + " in trajectory.tum");
+    }
+  }
   const auto slam_error = slam::trajectory_error(estimate, truth);
   const auto odometry_error = slam::trajectory_error(odometry, truth);
+  const auto online_error = slam::trajectory_error(online, truth);
 
   slam::Points2 map_points;
   for (const io::MapPointRecord &p : io::read_map_csv(run_dir / "map.csv"))
@@ -70,23 +82,28 @@ void evaluate(const std::filesystem::path &run_dir, const std::filesystem::path 
   std::printf("trajectory (%zu frames): rmse %.1f mm, max %.1f mm (frame %d), final %.1f mm\n",
               estimate.size(), slam_error.rmse_m * 1e3, slam_error.max_m * 1e3,
               frame_of[slam_error.max_frame] + 1, slam_error.final_m * 1e3);
+  if (has_online) {
+    std::printf("online (as published):   rmse %.1f mm, max %.1f mm (frame %d), final %.1f mm\n",
+                online_error.rmse_m * 1e3, online_error.max_m * 1e3, frame_of[online_error.max_frame] + 1,
+                online_error.final_m * 1e3);
+  }
   std::printf("odometry alone:          rmse %.1f mm, max %.1f mm (frame %d), final %.1f mm\n",
               odometry_error.rmse_m * 1e3, odometry_error.max_m * 1e3, frame_of[odometry_error.max_frame] + 1,
               odometry_error.final_m * 1e3);
   std::printf("map (%zu points): median distance to floor plan %.1f mm, p90 %.1f mm, completeness %.1f%%\n",
               map.points, map.median_distance_m * 1e3, map.p90_distance_m * 1e3, map.completeness * 100.0);
 
-  // The covariance against the errors, when the run wrote one per pose.
+  // The covariance (of the online poses) against their errors, when the run wrote one per pose.
   std::optional<slam::CovarianceConsistency> consistency;
   if (std::filesystem::exists(run_dir / "covariance.csv")) {
     const auto rows = io::read_covariance_csv(run_dir / "covariance.csv");
     if (rows.size() != estimate.size()) {
       throw std::runtime_error((run_dir / "covariance.csv").string() + ": " + std::to_string(rows.size()) +
-                               " rows for " + std::to_string(estimate.size()) + " poses in trajectory.tum");
+                               " rows for " + std::to_string(estimate.size()) + " poses in the trajectory");
     }
     std::vector<Eigen::Matrix3d> covariances;
     for (const io::CovarianceRecord &row : rows) covariances.push_back(row.covariance);
-    consistency = slam::covariance_consistency(estimate, truth, covariances);
+    consistency = slam::covariance_consistency(online, truth, covariances);
     std::printf(
         "covariance (%d frames): mean NEES %.1f (consistent: ~3), %.1f%% of positions inside their 95%% "
         "ellipse\n",
@@ -95,6 +112,7 @@ void evaluate(const std::filesystem::path &run_dir, const std::filesystem::path 
 
   nlohmann::json out;
   out["ate"] = to_json(slam_error, frame_of[slam_error.max_frame] + 1);
+  if (has_online) out["online_ate"] = to_json(online_error, frame_of[online_error.max_frame] + 1);
   if (consistency) {
     out["covariance"] = {{"frames", consistency->frames},
                          {"mean_nees", consistency->mean_nees},

@@ -16,6 +16,8 @@ namespace omnislam::app {
   record.skipped = frame.skipped();
   record.integrated = frame.estimate.integrated;
   record.localized = frame.localized;
+  record.keyframe = frame.estimate.keyframe;
+  record.loop_closed = frame.estimate.loop_closed;
   record.attempt = frame.estimate.attempt;
   record.srel_percent = frame.estimate.registration.srel_percent;
   record.iterations = frame.estimate.registration.iterations;

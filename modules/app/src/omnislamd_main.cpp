@@ -314,7 +314,7 @@ int run_service(const std::string &config_file) {
     info.name = "omnislamd";
     for (const FrameRecord &f : run.frames)
       run.odometry_map.push_back(run.frames.front().T_odom_base.inverse() * f.T_odom_base);
-    OutputWriter(service.output_dir).write_all(run, pipeline.slam().map(), info);
+    OutputWriter(service.output_dir).write_all(run, pipeline.slam().map(), info, pipeline.slam().trajectory());
     if (final_grid.width > 0)
       io::write_nav2_map(std::filesystem::path(service.output_dir) / "map.yaml", final_grid);
   }

@@ -108,7 +108,7 @@ void run_replay(const ReplayOptions &options, std::optional<std::uint64_t> degra
   }
   pipeline.run(dataset_source(info, odometry, config.scan.camera, std::move(source_options)));
   if (!pipeline.error().empty()) throw std::runtime_error(pipeline.error());
-  writer.write_all(run, pipeline.slam().map(), info);
+  writer.write_all(run, pipeline.slam().map(), info, pipeline.slam().trajectory());
   if (run.localizing) {
     const auto first = std::find_if(run.frames.begin(), run.frames.end(), [](const FrameRecord &f) { return f.localized; });
     if (first == run.frames.end()) {

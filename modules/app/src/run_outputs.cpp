@@ -167,18 +167,22 @@ void OutputWriter::write_thesis_map(int frame, const std::vector<slam::MapPoint>
   io::write_text_file(dir_ / ("mapa" + std::to_string(frame) + ".txt"), out.str());
 }
 
-void OutputWriter::write_all(const RunRecord &all, const slam::PointMap &map,
-                             const io::DatasetInfo &info) const {
+void OutputWriter::write_all(const RunRecord &all, const slam::PointMap &map, const io::DatasetInfo &info,
+                             const std::vector<Eigen::Isometry2d> &optimised) const {
   // Frames still searching for their pose on a saved map have none: the pose files, the
   // covariance and the errors are of the frames that have one (all of them, unless localizing).
   const RunRecord run = with_pose(all);
-  std::vector<io::StampedPose> trajectory;
-  std::vector<Eigen::Isometry2d> estimate;
+  std::vector<io::StampedPose> trajectory, trajectory_online;
+  std::vector<Eigen::Isometry2d> online;
   for (const FrameRecord &f : run.frames) {
-    trajectory.push_back(io::to_stamped(f.t_s, f.T_map_base));
-    estimate.push_back(f.T_map_base);
+    trajectory_online.push_back(io::to_stamped(f.t_s, f.T_map_base));
+    online.push_back(f.T_map_base);
   }
+  const std::vector<Eigen::Isometry2d> estimate = optimised.size() == run.frames.size() ? optimised : online;
+  for (std::size_t i = 0; i < run.frames.size(); ++i)
+    trajectory.push_back(io::to_stamped(run.frames[i].t_s, estimate[i]));
   io::write_tum_file(dir_ / "trajectory.tum", trajectory);
+  io::write_tum_file(dir_ / "trajectory_online.tum", trajectory_online);
   const auto records = map_records(map);
   io::write_map_csv(dir_ / "map.csv", records);
   io::write_map_ply(dir_ / "map.ply", records);
@@ -198,6 +202,9 @@ void OutputWriter::write_all(const RunRecord &all, const slam::PointMap &map,
   summary["not_integrated"] = static_cast<long>(all.frames.size()) - integrated;
   summary["skipped"] = std::count_if(all.frames.begin(), all.frames.end(), [](auto &f) { return f.skipped; });
   if (all.localizing) summary["not_localized"] = all.frames.size() - run.frames.size();
+  summary["keyframes"] = std::count_if(run.frames.begin(), run.frames.end(), [](auto &f) { return f.keyframe; });
+  summary["loop_closures"] =
+      std::count_if(run.frames.begin(), run.frames.end(), [](auto &f) { return f.loop_closed; });
   summary["map_points"] = map.points().size();
   summary["stage_ms"] = stage_statistics(run.frames);
   std::vector<double> latency_ms;
@@ -216,6 +223,7 @@ void OutputWriter::write_all(const RunRecord &all, const slam::PointMap &map,
     const auto slam_error = slam::trajectory_error(estimate, run.ground_truth);
     const auto odometry_error = slam::trajectory_error(run.odometry_map, run.ground_truth);
     summary["ate"] = errors_json(slam_error);
+    summary["online_ate"] = errors_json(slam::trajectory_error(online, run.ground_truth));
     summary["odometry_ate"] = errors_json(odometry_error);
     std::printf(
         "%s: %zu frames, %ld integrated; position error max %.1f mm, final %.1f mm, rmse %.1f mm "

@@ -19,8 +19,12 @@ class OutputWriter {
   /// mapaN.txt: the global map after image N (thesis format: x y count, millimetres).
   void write_thesis_map(int frame, const std::vector<slam::MapPoint> &points) const;
 
-  /// Everything else, once the run is over.
-  void write_all(const RunRecord &run, const slam::PointMap &map, const io::DatasetInfo &info) const;
+  /// Everything else, once the run is over. `optimised` is every frame's final pose
+  /// (slam::Slam::trajectory(); trajectory.tum); the frames' poses as they were published go
+  /// to trajectory_online.tum, with covariance.csv. An `optimised` of another length than
+  /// the frames (no pose graph) makes the two trajectories equal.
+  void write_all(const RunRecord &run, const slam::PointMap &map, const io::DatasetInfo &info,
+                 const std::vector<Eigen::Isometry2d> &optimised = {}) const;
 
  private:
   std::filesystem::path dir_;

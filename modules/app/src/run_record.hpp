@@ -25,6 +25,8 @@ struct FrameRecord {
   bool skipped = false;  ///< the image could not be used
   bool integrated = false;
   bool localized = true;  ///< false: still searching for its pose on a saved map (no pose)
+  bool keyframe = false;     ///< became a keyframe of the pose graph
+  bool loop_closed = false;  ///< a loop closure corrected the graph at this frame
   slam::Attempt attempt = slam::Attempt::kNone;
   double srel_percent = 0.0;
   int iterations = 0;

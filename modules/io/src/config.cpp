@@ -126,6 +126,75 @@ void read_stereo(YamlSection &section, stereo::StereoConfig &stereo) {
     section.fail("far_cutoff_m", "must exceed near_cutoff_m");
 }
 
+// slam.loop_closure: keyframes, the pose graph and loop acceptance (README "Loop closure").
+void read_loop_closure(YamlSection &section, slam::LoopClosureConfig &loops) {
+  section.read("enabled", loops.enabled);
+  slam::KeyframeConfig &keyframes = loops.keyframes;
+  section.read("keyframe_distance_m", keyframes.keyframe_distance_m);
+  read_degrees(section, "keyframe_angle_deg", keyframes.keyframe_angle_rad);
+  section.read("edge_floor_xy_m", keyframes.edge_floor_xy_m);
+  read_degrees(section, "edge_floor_yaw_deg", keyframes.edge_floor_yaw_rad);
+  section.read("drift_per_m", keyframes.drift_per_m);
+  read_degrees(section, "drift_yaw_deg_per_m", keyframes.drift_yaw_per_m);
+  section.read("min_path_gap_m", loops.min_path_gap_m);
+  section.read("submap_path_m", loops.submap_path_m);
+  section.read("max_candidate_distance_m", loops.max_candidate_distance_m);
+  section.read("max_candidates", loops.max_candidates);
+  section.read("max_window_m", loops.max_window_m);
+  read_degrees(section, "max_window_deg", loops.max_window_rad);
+  section.read("grid_resolution_m", loops.grid_resolution_m);
+  section.read("max_sample_points", loops.max_sample_points);
+  section.read("min_score", loops.min_score);
+  section.read("ambiguity_ratio", loops.ambiguity_ratio);
+  section.read("distinct_m", loops.distinct_m);
+  read_degrees(section, "distinct_deg", loops.distinct_rad);
+  section.read("max_rms_m", loops.max_rms_m);
+  section.read("min_overlap", loops.min_overlap);
+  section.read("min_weak_direction_share", loops.min_weak_direction_share);
+  section.read("agreement_m", loops.agreement_m);
+  read_degrees(section, "agreement_deg", loops.agreement_rad);
+  section.read("loop_floor_xy_m", loops.loop_floor_xy_m);
+  read_degrees(section, "loop_floor_yaw_deg", loops.loop_floor_yaw_rad);
+  section.read("loop_chi2_limit", loops.graph.loop_chi2_limit);
+  section.read("loop_loss_scale", loops.graph.loop_loss_scale);
+  section.read("rebuild_min_shift_m", loops.rebuild_min_shift_m);
+  for (const auto &[key, value] : {std::pair{"keyframe_distance_m", keyframes.keyframe_distance_m},
+                                   {"keyframe_angle_deg", keyframes.keyframe_angle_rad},
+                                   {"edge_floor_xy_m", keyframes.edge_floor_xy_m},
+                                   {"edge_floor_yaw_deg", keyframes.edge_floor_yaw_rad},
+                                   {"submap_path_m", loops.submap_path_m},
+                                   {"max_window_m", loops.max_window_m},
+                                   {"grid_resolution_m", loops.grid_resolution_m},
+                                   {"distinct_m", loops.distinct_m},
+                                   {"max_rms_m", loops.max_rms_m},
+                                   {"agreement_m", loops.agreement_m},
+                                   {"loop_floor_xy_m", loops.loop_floor_xy_m},
+                                   {"loop_floor_yaw_deg", loops.loop_floor_yaw_rad},
+                                   {"loop_chi2_limit", loops.graph.loop_chi2_limit},
+                                   {"loop_loss_scale", loops.graph.loop_loss_scale}}) {
+    if (!(value > 0.0)) section.fail(key, "must be positive");
+  }
+  for (const auto &[key, value] : {std::pair{"drift_per_m", keyframes.drift_per_m},
+                                   {"drift_yaw_deg_per_m", keyframes.drift_yaw_per_m},
+                                   {"min_path_gap_m", loops.min_path_gap_m},
+                                   {"max_candidate_distance_m", loops.max_candidate_distance_m},
+                                   {"max_window_deg", loops.max_window_rad},
+                                   {"distinct_deg", loops.distinct_rad},
+                                   {"agreement_deg", loops.agreement_rad},
+                                   {"rebuild_min_shift_m", loops.rebuild_min_shift_m}}) {
+    if (value < 0.0) section.fail(key, "must be >= 0");
+  }
+  for (const auto &[key, value] : {std::pair{"min_score", loops.min_score},
+                                   {"ambiguity_ratio", loops.ambiguity_ratio},
+                                   {"min_overlap", loops.min_overlap},
+                                   {"min_weak_direction_share", loops.min_weak_direction_share}}) {
+    if (!(value >= 0.0 && value <= 1.0)) section.fail(key, "must be in [0, 1]");
+  }
+  if (loops.max_candidates < 1 || loops.max_candidates > 50) section.fail("max_candidates", "must be in 1..50");
+  if (loops.max_sample_points < 10 || loops.max_sample_points > 10000)
+    section.fail("max_sample_points", "must be in 10..10000");
+}
+
 void read_slam(YamlSection &section, slam::SlamConfig &slam) {
   read_choice(
       section, "target", slam.target,
@@ -159,6 +228,8 @@ void read_slam(YamlSection &section, slam::SlamConfig &slam) {
   section.read("prune_min_hits", slam.map.prune_min_hits);
   section.read("prune_min_age", slam.map.prune_min_age);
   section.read("localization_only", slam.localization_only);
+  detail::read_section(section, "loop_closure",
+                       [&slam](YamlSection &loops) { read_loop_closure(loops, slam.loop_closure); });
   if (!(slam.icp.overlap > 0.0 && slam.icp.overlap <= 1.0)) section.fail("overlap", "must be in (0, 1]");
   if (!(slam.icp.initial_search_radius_m > 0.0)) section.fail("initial_search_radius_m", "must be positive");
   if (slam.icp.max_iterations < 1 || slam.icp.max_iterations > 1000) {

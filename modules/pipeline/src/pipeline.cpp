@@ -292,7 +292,8 @@ void Pipeline::slam_loop() {
       const bool due = config_.map_period_s > 0.0 &&
                        (last_map == Clock::time_point::min() ||
                         now - last_map >= std::chrono::duration<double>(config_.map_period_s));
-      if (config_.map_every_integration || due) {
+      // A loop closure rebuilt the map: publish the corrected one now.
+      if (config_.map_every_integration || due || frame->estimate.map_rebuilt) {
         frame->map = std::make_shared<const std::vector<slam::MapPoint>>(slam_.map().points());
         last_map = now;
       }

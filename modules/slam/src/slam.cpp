@@ -105,6 +105,13 @@ FrameEstimate Slam::register_scan(const Points2 &scan_base, const Eigen::Isometr
 
 void Slam::resume(std::vector<MapPoint> points, int integrations, const Eigen::Isometry2d &T_map_base,
                   const Eigen::Matrix3d &covariance, const std::optional<Eigen::Isometry2d> &T_odom_base) {
+  if (config_.loop_closure.enabled) {
+    restored_points_ = points;  // the graph's corrections move what is added to it, not this
+    restored_integrations_ = integrations;
+  }
+  keyframes_ = KeyframeGraph(config_.loop_closure.keyframes);
+  pending_loop_.reset();
+  last_loop_.reset();
   map_ = PointMap(config_.map, std::move(points), integrations);
   started_ = true;
   anchor_T_odom_base_ = T_odom_base;
@@ -140,7 +147,52 @@ FrameEstimate Slam::seed_map(const Points2 &scan_base) {
   previous_ = {previous_.T_map_base, true, Attempt::kFirstFrame, {}, previous_.covariance};
   recent_scans_map_.assign(1, transformed(scan_base, previous_.T_map_base));
   map_.integrate(recent_scans_map_.front());
+  if (config_.loop_closure.enabled) {
+    previous_.keyframe = keyframes_.add_integrated(scan_base, previous_.T_map_base, previous_.covariance);
+  } else {
+    keyframes_.add_pose(previous_.T_map_base);
+  }
   return previous_;
+}
+
+Eigen::Isometry2d Slam::update_graph(const Points2 &scan_base, FrameEstimate &estimate) {
+  const LoopClosureConfig &loops = config_.loop_closure;
+  estimate.keyframe = keyframes_.add_integrated(scan_base, estimate.T_map_base, estimate.covariance);
+  if (!estimate.keyframe) return estimate.T_map_base;
+
+  // A loop hypothesis is verified at this keyframe, and used only when the previous
+  // keyframe's agrees with it (one match can be fooled; two in a row rarely are).
+  const LoopMatch match = search_loop(keyframes_, loops, config_.icp, last_loop_);
+  if (match.status != LoopStatus::kAccepted) {
+    pending_loop_.reset();
+    return estimate.T_map_base;
+  }
+  const bool confirmed = pending_loop_ && pending_loop_->current == match.current - 1 &&
+                         agree(keyframes_, *pending_loop_, match, loops);
+  if (!confirmed) {
+    pending_loop_ = match;
+    return estimate.T_map_base;
+  }
+  if (!keyframes_.has_loop(pending_loop_->current))
+    keyframes_.add_loop(pending_loop_->candidate, pending_loop_->current, pending_loop_->T_candidate_current,
+                        pending_loop_->covariance);
+  keyframes_.add_loop(match.candidate, match.current, match.T_candidate_current, match.covariance);
+  pending_loop_ = match;
+  last_loop_ = match;
+
+  // Optimise (warm start: the graph holds the current estimate), then let the map and the
+  // tracking state follow the corrected keyframes.
+  const KeyframeGraph::Correction correction = keyframes_.optimize(loops.graph);
+  ++loop_closures_;
+  estimate.loop_closed = true;
+  if (correction.max_shift_m > loops.rebuild_min_shift_m) {
+    map_ = keyframes_.rebuilt_map(config_.map, restored_points_, restored_integrations_);
+    estimate.map_rebuilt = true;
+  }
+  const Eigen::Isometry2d corrected = keyframes_.keyframes().back().T_map_keyframe;
+  const Eigen::Isometry2d T_corrected_tracked = corrected * estimate.T_map_base.inverse();
+  for (Points2 &scan : recent_scans_map_) scan = transformed(scan, T_corrected_tracked);
+  return corrected;
 }
 
 FrameEstimate Slam::process(const Points2 &scan_base, const std::optional<Eigen::Isometry2d> &T_odom_base) {
@@ -179,13 +231,19 @@ FrameEstimate Slam::process(const Points2 &scan_base, const std::optional<Eigen:
       estimate.T_map_base = refined.T_model_sample;
   }
 
+  bool in_graph = false;  // recorded as an integrated frame of the keyframe graph
   if (estimate.integrated) {
     relaxation_percent_ = 0.0;
     // A frame without odometry is registered but never changes the map: along a corridor
     // the scan fits anywhere, and only odometry tells where.
     const bool odometry_gap = config_.use_odometry && !T_odom_base;
-    if (!config_.localization_only && !odometry_gap)
+    if (!config_.localization_only && !odometry_gap) {
       map_.integrate(transformed(scan_base, estimate.T_map_base));
+      if (config_.loop_closure.enabled) {
+        estimate.T_map_base = update_graph(scan_base, estimate);
+        in_graph = true;
+      }
+    }
   } else {
     relaxation_percent_ += config_.srel_relax_percent;
     const Eigen::Matrix2d R = previous_.T_map_base.linear();
@@ -193,6 +251,7 @@ FrameEstimate Slam::process(const Points2 &scan_base, const std::optional<Eigen:
     rotate.topLeftCorner<2, 2>() = R;
     estimate.covariance = previous_.covariance + rotate * odometry_step_covariance(step) * rotate.transpose();
   }
+  if (!in_graph) keyframes_.add_pose(estimate.T_map_base);
   previous_failed_ = !estimate.integrated;
   if (T_odom_base) set_anchor(*T_odom_base, estimate.T_map_base);
   last_step_ = previous_.T_map_base.inverse() * estimate.T_map_base;  // extrapolated through gaps

@@ -4,6 +4,8 @@
 #include <deque>
 #include <optional>
 
+#include "omnislam/slam/keyframe_graph.hpp"
+#include "omnislam/slam/loop_closure.hpp"
 #include "omnislam/slam/nearest_neighbors.hpp"
 #include "omnislam/slam/point_map.hpp"
 #include "omnislam/slam/trimmed_icp.hpp"
@@ -50,6 +52,10 @@ struct SlamConfig {
   /// Localization only: frames are registered against the (restored) map as usual, but
   /// nothing is ever integrated, so the map stays exactly as it was loaded.
   bool localization_only = false;
+  /// Keyframes, a pose graph over them and loop closure (beyond the thesis). When a loop
+  /// closes, the keyframe poses are optimised, the map is rebuilt from them and the current
+  /// pose follows the correction.
+  LoopClosureConfig loop_closure;
 };
 
 /// Which registration was accepted for a frame.
@@ -69,11 +75,15 @@ struct FrameEstimate {
   Attempt attempt = Attempt::kNone;
   TrimmedIcpResult registration;                         ///< the accepted one, or the last tried
   Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();  ///< (x, y, yaw) in the map frame
+  bool keyframe = false;      ///< the frame became a keyframe of the pose graph
+  bool loop_closed = false;   ///< a loop closure corrected the graph (and T_map_base) at this frame
+  bool map_rebuilt = false;   ///< ... and the map was rebuilt from the optimised keyframes
 };
 
 class Slam {
  public:
-  explicit Slam(SlamConfig config = {}) : config_(config), map_(config.map) {}
+  explicit Slam(SlamConfig config = {})
+      : config_(config), map_(config.map), keyframes_(config.loop_closure.keyframes) {}
 
   /// Processes one local scan (base_link points, metres) with the odometry pose of the
   /// same frame (any fixed odom frame). The first frame defines the map frame, unless the
@@ -103,6 +113,12 @@ class Slam {
   void set_pose(const Eigen::Isometry2d &T_map_base, const Eigen::Matrix3d &covariance);
 
   [[nodiscard]] const PointMap &map() const { return map_; }
+  /// Every processed frame's pose following the optimised pose graph (its keyframe's pose
+  /// composed with where the frame was relative to it); without loop closure, the poses
+  /// as they were estimated.
+  [[nodiscard]] std::vector<Eigen::Isometry2d> trajectory() const { return keyframes_.trajectory(); }
+  [[nodiscard]] const KeyframeGraph &keyframes() const { return keyframes_; }
+  [[nodiscard]] int loop_closures() const { return loop_closures_; }
 
  private:
   [[nodiscard]] bool accept(const TrimmedIcpResult &registration, const Eigen::Isometry2d &predicted,
@@ -119,8 +135,19 @@ class Slam {
                                              const Eigen::Isometry2d &predicted,
                                              const Eigen::Isometry2d &estimate) const;
 
+  /// Adds an integrated frame to the keyframe graph; at a new keyframe, searches for a loop
+  /// and, when one is confirmed, optimises the graph and rebuilds the map. Returns the
+  /// frame's pose after any correction.
+  [[nodiscard]] Eigen::Isometry2d update_graph(const Points2 &scan_base, FrameEstimate &estimate);
+
   SlamConfig config_;
   PointMap map_;
+  KeyframeGraph keyframes_;
+  std::optional<LoopMatch> pending_loop_;  ///< the previous keyframe's verified loop, to be confirmed
+  std::optional<LoopMatch> last_loop_;     ///< the last loop edge added (narrows the next search)
+  int loop_closures_ = 0;
+  std::vector<MapPoint> restored_points_;  ///< a resumed map: the base every rebuild starts from
+  int restored_integrations_ = 0;
   bool started_ = false;
   /// The last frame that had odometry: its odometry pose and its estimate. Predictions
   /// compose the odometry motion since onto it.

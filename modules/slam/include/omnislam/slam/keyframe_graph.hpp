@@ -1,0 +1,98 @@
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <vector>
+
+#include "omnislam/slam/nearest_neighbors.hpp"
+#include "omnislam/slam/point_map.hpp"
+#include "omnislam/slam/pose_graph.hpp"
+
+/// @file
+/// Keyframes of a SLAM run and the pose graph over them. A keyframe is an integrated frame
+/// taken after the robot travelled keyframe_distance_m or turned keyframe_angle_rad since
+/// the last one; it keeps every integrated frame's scan until the next keyframe, in its own
+/// coordinates, so the map can be rebuilt from the optimised keyframe poses. Every frame
+/// (keyframe or not) is remembered relative to the keyframe it followed, so the whole
+/// trajectory follows the graph. Not thread-safe.
+
+namespace omnislam::slam {
+
+struct KeyframeConfig {
+  double keyframe_distance_m = 0.5;  ///< travel that makes the next integrated frame a keyframe
+  double keyframe_angle_rad = 0.3491;  ///< or turn (20 deg)
+  /// Standard deviation of a sequential edge: a floor (so an exact or degenerate fit never
+  /// gives infinite confidence) plus drift_per_m per metre between the two keyframes.
+  double edge_floor_xy_m = 0.01;
+  double edge_floor_yaw_rad = 0.0087;  ///< 0.5 deg
+  double drift_per_m = 0.03;           ///< position drift of scan-to-map tracking, m per m travelled
+  double drift_yaw_per_m = 0.0087;     ///< heading drift, rad per m travelled (0.5 deg/m)
+};
+
+struct Keyframe {
+  Eigen::Isometry2d T_map_keyframe = Eigen::Isometry2d::Identity();  ///< the graph's current value
+  double path_m = 0.0;                ///< distance travelled from the first keyframe
+  std::vector<Points2> scans_keyframe;  ///< the integrated scans it holds, keyframe coordinates
+};
+
+class KeyframeGraph {
+ public:
+  explicit KeyframeGraph(KeyframeConfig config = {}) : config_(config) {}
+
+  /// Records an integrated frame at `T_map_base` with its scan (base_link); it becomes a
+  /// keyframe (joined to the previous one by a sequential edge whose covariance is the
+  /// registration's plus the drift floor) when far enough from the last one. Returns
+  /// whether it did.
+  bool add_integrated(const Points2 &scan_base, const Eigen::Isometry2d &T_map_base,
+                      const Eigen::Matrix3d &registration_covariance);
+  /// Records a frame that was not integrated (only its pose, relative to the last keyframe).
+  void add_pose(const Eigen::Isometry2d &T_map_base);
+
+  /// Adds a loop edge: keyframe `current` seen at T_candidate_current from `candidate`.
+  void add_loop(int candidate, int current, const Eigen::Isometry2d &T_candidate_current,
+                const Eigen::Matrix3d &covariance);
+  /// Whether keyframe `current` already has a loop edge.
+  [[nodiscard]] bool has_loop(int current) const;
+  /// Solves the graph (warm start from the current keyframe poses) and takes its poses.
+  /// Returns the solver's report and the largest keyframe displacement it made.
+  struct Correction {
+    PoseGraphResult solve;
+    double max_shift_m = 0.0;
+  };
+  Correction optimize(const PoseGraphConfig &config);
+
+  /// The scans of the keyframes whose path position lies within `path_radius_m` of
+  /// keyframe `center`'s (and not beyond `max_path_m`), in `center`'s coordinates.
+  [[nodiscard]] Points2 submap(int center, double path_radius_m, double max_path_m) const;
+  /// A new map of `base` (restored points, may be empty) plus every stored scan at its
+  /// keyframe's current pose, integrated in the order they were first integrated.
+  [[nodiscard]] PointMap rebuilt_map(const PointMapConfig &config, const std::vector<MapPoint> &base,
+                                     int base_integrations) const;
+
+  /// Every recorded frame's pose following its keyframe's current pose (frames before the
+  /// first keyframe keep the pose they were recorded with).
+  [[nodiscard]] std::vector<Eigen::Isometry2d> trajectory() const;
+
+  [[nodiscard]] const std::vector<Keyframe> &keyframes() const { return keyframes_; }
+  [[nodiscard]] int last() const { return static_cast<int>(keyframes_.size()) - 1; }
+  [[nodiscard]] const PoseGraph &graph() const { return graph_; }
+  [[nodiscard]] const KeyframeConfig &config() const { return config_; }
+
+ private:
+  struct FrameAnchor {
+    int keyframe = -1;  ///< -1: before any keyframe, T is then in the map frame
+    Eigen::Isometry2d T_keyframe_base = Eigen::Isometry2d::Identity();
+  };
+  [[nodiscard]] FrameAnchor anchor(const Eigen::Isometry2d &T_map_base) const;
+
+  KeyframeConfig config_;
+  std::vector<Keyframe> keyframes_;
+  std::vector<FrameAnchor> frames_;
+  /// Order of integration: (keyframe, scan index within it), to rebuild the map as it grew.
+  std::vector<std::pair<int, int>> integration_order_;
+  PoseGraph graph_;
+  double path_m_ = 0.0;  ///< travelled so far, summed frame to frame
+  Eigen::Isometry2d last_frame_ = Eigen::Isometry2d::Identity();
+};
+
+}  // namespace omnislam::slam

@@ -1,0 +1,128 @@
+#include "omnislam/slam/keyframe_graph.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "omnislam/slam/planar_pose.hpp"
+
+namespace omnislam::slam {
+namespace {
+
+Points2 transformed(const Points2 &points, const Eigen::Isometry2d &T) {
+  Points2 out;
+  out.reserve(points.size());
+  for (const Point2 &p : points) out.push_back(T * p);
+  return out;
+}
+
+// A (x, y, yaw) covariance given in the map frame, expressed in a frame turned by R.
+Eigen::Matrix3d in_frame(const Eigen::Matrix3d &covariance_map, const Eigen::Matrix2d &R_map_frame) {
+  Eigen::Matrix3d rotate = Eigen::Matrix3d::Identity();
+  rotate.topLeftCorner<2, 2>() = R_map_frame.transpose();
+  return rotate * covariance_map * rotate.transpose();
+}
+
+}  // namespace
+
+KeyframeGraph::FrameAnchor KeyframeGraph::anchor(const Eigen::Isometry2d &T_map_base) const {
+  if (keyframes_.empty()) return {-1, T_map_base};
+  return {last(), keyframes_.back().T_map_keyframe.inverse() * T_map_base};
+}
+
+void KeyframeGraph::add_pose(const Eigen::Isometry2d &T_map_base) {
+  frames_.push_back(anchor(T_map_base));
+  if (!keyframes_.empty()) path_m_ += (T_map_base.translation() - last_frame_.translation()).norm();
+  last_frame_ = T_map_base;
+}
+
+bool KeyframeGraph::add_integrated(const Points2 &scan_base, const Eigen::Isometry2d &T_map_base,
+                                   const Eigen::Matrix3d &registration_covariance) {
+  if (!keyframes_.empty()) path_m_ += (T_map_base.translation() - last_frame_.translation()).norm();
+  last_frame_ = T_map_base;
+  bool is_keyframe = keyframes_.empty();
+  if (!is_keyframe) {
+    const Eigen::Isometry2d step = keyframes_.back().T_map_keyframe.inverse() * T_map_base;
+    is_keyframe = step.translation().norm() >= config_.keyframe_distance_m ||
+                  std::abs(yaw_rad_of(step)) >= config_.keyframe_angle_rad;
+  }
+  if (is_keyframe) {
+    const int node = graph_.add_node(T_map_base);
+    if (node > 0) {
+      // The sequential edge: the relative pose the tracking produced, with the
+      // registration's covariance plus the drift the tracking can accumulate over it.
+      const Keyframe &previous = keyframes_.back();
+      const Eigen::Isometry2d T_previous_current = previous.T_map_keyframe.inverse() * T_map_base;
+      const double travelled_m = path_m_ - previous.path_m;
+      const double sigma_xy = config_.edge_floor_xy_m + config_.drift_per_m * travelled_m;
+      const double sigma_yaw = config_.edge_floor_yaw_rad + config_.drift_yaw_per_m * travelled_m;
+      const Eigen::Matrix3d covariance =
+          in_frame(registration_covariance, previous.T_map_keyframe.linear()) +
+          Eigen::Vector3d(sigma_xy * sigma_xy, sigma_xy * sigma_xy, sigma_yaw * sigma_yaw).asDiagonal().toDenseMatrix();
+      graph_.add_edge({node - 1, node, T_previous_current, covariance.inverse(), false});
+    }
+    keyframes_.push_back({T_map_base, path_m_, {}});
+  }
+  frames_.push_back(anchor(T_map_base));
+  keyframes_.back().scans_keyframe.push_back(transformed(scan_base, frames_.back().T_keyframe_base));
+  integration_order_.emplace_back(last(), static_cast<int>(keyframes_.back().scans_keyframe.size()) - 1);
+  return is_keyframe;
+}
+
+void KeyframeGraph::add_loop(int candidate, int current, const Eigen::Isometry2d &T_candidate_current,
+                             const Eigen::Matrix3d &covariance) {
+  graph_.add_edge({candidate, current, T_candidate_current, covariance.inverse(), true});
+}
+
+bool KeyframeGraph::has_loop(int current) const {
+  return std::any_of(graph_.edges().begin(), graph_.edges().end(),
+                     [&](const PoseGraphEdge &edge) { return edge.loop && edge.to == current; });
+}
+
+KeyframeGraph::Correction KeyframeGraph::optimize(const PoseGraphConfig &config) {
+  Correction correction;
+  correction.solve = graph_.optimize(config);
+  for (int k = 0; k <= last(); ++k) {
+    Keyframe &keyframe = keyframes_[static_cast<std::size_t>(k)];
+    const Eigen::Isometry2d optimised = graph_.pose(k);
+    correction.max_shift_m =
+        std::max(correction.max_shift_m, (optimised.translation() - keyframe.T_map_keyframe.translation()).norm());
+    keyframe.T_map_keyframe = optimised;
+  }
+  return correction;
+}
+
+Points2 KeyframeGraph::submap(int center, double path_radius_m, double max_path_m) const {
+  const Keyframe &middle = keyframes_[static_cast<std::size_t>(center)];
+  const Eigen::Isometry2d T_center_map = middle.T_map_keyframe.inverse();
+  Points2 points;
+  for (const Keyframe &keyframe : keyframes_) {
+    if (std::abs(keyframe.path_m - middle.path_m) > path_radius_m || keyframe.path_m > max_path_m) continue;
+    const Eigen::Isometry2d T_center_keyframe = T_center_map * keyframe.T_map_keyframe;
+    for (const Points2 &scan : keyframe.scans_keyframe)
+      for (const Point2 &p : scan) points.push_back(T_center_keyframe * p);
+  }
+  return points;
+}
+
+PointMap KeyframeGraph::rebuilt_map(const PointMapConfig &config, const std::vector<MapPoint> &base,
+                                    int base_integrations) const {
+  PointMap map = base.empty() ? PointMap(config) : PointMap(config, base, base_integrations);
+  for (const auto &[k, scan] : integration_order_) {
+    const Keyframe &keyframe = keyframes_[static_cast<std::size_t>(k)];
+    map.integrate(transformed(keyframe.scans_keyframe[static_cast<std::size_t>(scan)], keyframe.T_map_keyframe));
+  }
+  return map;
+}
+
+std::vector<Eigen::Isometry2d> KeyframeGraph::trajectory() const {
+  std::vector<Eigen::Isometry2d> poses;
+  poses.reserve(frames_.size());
+  for (const FrameAnchor &frame : frames_) {
+    poses.push_back(frame.keyframe < 0
+                        ? frame.T_keyframe_base
+                        : keyframes_[static_cast<std::size_t>(frame.keyframe)].T_map_keyframe * frame.T_keyframe_base);
+  }
+  return poses;
+}
+
+}  // namespace omnislam::slam
