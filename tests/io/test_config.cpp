@@ -126,7 +126,8 @@ TEST_CASE("config: the rig's misalignments in the camera section, bad values nam
   CHECK(rig.mirror_offset_x_mm == 0.7);
   CHECK(rig.mirror_offset_y_mm == -0.4);
   CHECK_FALSE(rig.nominal());
-  CHECK(omnislam::io::load_config(write_file("norig.yaml", "camera:\n  width: 1024\n")).scan.camera.rig.nominal());
+  CHECK(omnislam::io::load_config(write_file("norig.yaml", "camera:\n  width: 1024\n"))
+            .scan.camera.rig.nominal());
   const std::pair<const char *, const char *> bad[] = {
       {"camera:\n  focal_scale: 0\n", "camera.focal_scale"},
       {"camera:\n  mirror_dz_mm: 270\n", "camera.mirror_dz_mm"},

@@ -1,6 +1,6 @@
 #include <Eigen/Core>
-#include <catch2/catch.hpp>
 #include <algorithm>
+#include <catch2/catch.hpp>
 #include <cmath>
 #include <limits>
 #include <numbers>
@@ -35,7 +35,8 @@ MirrorConfig perturbed_config() {
 }
 
 Pixel pixel_at(const MirrorConfig &config, double radius_px, double phi_rad) {
-  return {config.center_u_px + radius_px * std::cos(phi_rad), config.center_v_px + radius_px * std::sin(phi_rad)};
+  return {config.center_u_px + radius_px * std::cos(phi_rad),
+          config.center_v_px + radius_px * std::sin(phi_rad)};
 }
 
 double distance_to_line(const Ray3 &ray, const Eigen::Vector3d &point_m) {
@@ -59,9 +60,10 @@ TEST_CASE("rig model: a designed rig's traced rays are the closed-form rays", "[
         REQUIRE(ray);
         const omnislam::mirror::MeridianRay ideal = model.back_project(lobe, radius);
         const Eigen::Vector3d direction(std::sin(ideal.theta_rad) * std::cos(phi),
-                                        std::sin(ideal.theta_rad) * std::sin(phi), -std::cos(ideal.theta_rad));
-        const Eigen::Vector3d focus(ideal.origin.range_m * std::cos(phi), ideal.origin.range_m * std::sin(phi),
-                                    ideal.origin.height_m);
+                                        std::sin(ideal.theta_rad) * std::sin(phi),
+                                        -std::cos(ideal.theta_rad));
+        const Eigen::Vector3d focus(ideal.origin.range_m * std::cos(phi),
+                                    ideal.origin.range_m * std::sin(phi), ideal.origin.height_m);
         CHECK((ray->direction - direction).norm() < 1e-12);
         CHECK(distance_to_line(*ray, focus) < 1e-12);  // metres: the ray passes through the focus
       }
@@ -97,10 +99,10 @@ TEST_CASE("rig model: a designed rig triangulates like thesis eq. 2-6", "[mirror
     for (int outer_row = inner_row + 3; outer_row < 225; outer_row += 25) {
       const auto expected = model.triangulate_rows(inner_row, outer_row);
       const double phi = 2.0;
-      const auto inner =
-          rig.back_project(Lobe::kInner, pixel_at(model.config(), model.radius_px_of_row(Lobe::kInner, inner_row), phi));
-      const auto outer =
-          rig.back_project(Lobe::kOuter, pixel_at(model.config(), model.radius_px_of_row(Lobe::kOuter, outer_row), phi));
+      const auto inner = rig.back_project(
+          Lobe::kInner, pixel_at(model.config(), model.radius_px_of_row(Lobe::kInner, inner_row), phi));
+      const auto outer = rig.back_project(
+          Lobe::kOuter, pixel_at(model.config(), model.radius_px_of_row(Lobe::kOuter, outer_row), phi));
       REQUIRE(inner);
       REQUIRE(outer);
       const auto meet = RigModel::intersect(*inner, *outer);
@@ -116,7 +118,8 @@ TEST_CASE("rig model: a designed rig triangulates like thesis eq. 2-6", "[mirror
   CHECK(compared > 10);
 }
 
-TEST_CASE("rig model: back-projection and projection invert each other on a misaligned rig", "[mirror][rig]") {
+TEST_CASE("rig model: back-projection and projection invert each other on a misaligned rig",
+          "[mirror][rig]") {
   const MirrorConfig config = perturbed_config();
   const RigModel rig(config);
   for (const Lobe lobe : {Lobe::kInner, Lobe::kOuter}) {
@@ -206,13 +209,15 @@ TEST_CASE("panorama maps: a designed rig is unchanged; a rig misaligned by 1e-12
     const auto traced = omnislam::mirror::make_panorama_map(general, lobe);
     double worst = 0.0;
     for (std::size_t i = 0; i < ideal.u_px.size(); ++i)
-      worst = std::max(worst, static_cast<double>(std::hypot(ideal.u_px[i] - traced.u_px[i], ideal.v_px[i] - traced.v_px[i])));
+      worst = std::max(worst, static_cast<double>(std::hypot(ideal.u_px[i] - traced.u_px[i],
+                                                             ideal.v_px[i] - traced.v_px[i])));
     CAPTURE(static_cast<int>(lobe));
     CHECK(worst < 1e-3);  // float maps: ~1e-4 px is their resolution at radius 512
   }
 }
 
-TEST_CASE("panorama maps: on a misaligned rig floor points keep their designed rows", "[mirror][rig][unwarp]") {
+TEST_CASE("panorama maps: on a misaligned rig floor points keep their designed rows",
+          "[mirror][rig][unwarp]") {
   MirrorConfig config = perturbed_config();
   config.reference_depth_mm = 800.0;
   const MirrorModel model(config);
@@ -255,7 +260,8 @@ TEST_CASE("panorama maps: on a misaligned rig floor points keep their designed r
   }
 }
 
-TEST_CASE("rig model: rays agree with the renderer's tracer (scripts/omnislam_render/mirror.py)", "[mirror][rig]") {
+TEST_CASE("rig model: rays agree with the renderer's tracer (scripts/omnislam_render/mirror.py)",
+          "[mirror][rig]") {
   // Reference rays (camera frame, mm) printed by mirror.trace(lobe, u, v, rig) for
   // perturbed_config()'s rig: Rig(focal_scale=1.01, mirror_dz_mm=2.0, tilt_deg=(1.0, -0.6),
   // offset_mm=(1.0, -0.5), center_px=(514.5, 509.0)). The tracer bisects the lobe profile
@@ -267,15 +273,30 @@ TEST_CASE("rig model: rays agree with the renderer's tracer (scripts/omnislam_re
     Eigen::Vector3d origin_mm, direction;
   };
   const Reference references[] = {
-      {Lobe::kInner, 700.0, 400.0, {13.690969987167307, -8.044828725613066, 265.450262990289},
+      {Lobe::kInner,
+       700.0,
+       400.0,
+       {13.690969987167307, -8.044828725613066, 265.450262990289},
        {0.7918383556336687, -0.4462068340161421, -0.417002973400261}},
-      {Lobe::kInner, 430.0, 620.0, {-6.193641689217993, 8.136026360984788, 263.6223479435147},
+      {Lobe::kInner,
+       430.0,
+       620.0,
+       {-6.193641689217993, 8.136026360984788, 263.6223479435147},
        {-0.4911043165685821, 0.6231826120263073, -0.6086542387232465}},
-      {Lobe::kOuter, 900.0, 520.0, {43.95035220181366, 1.2540956529697214, 410.0443506265035},
+      {Lobe::kOuter,
+       900.0,
+       520.0,
+       {43.95035220181366, 1.2540956529697214, 410.0443506265035},
        {0.8343113459497917, 0.09653623489547677, -0.5427755828808553}},
-      {Lobe::kOuter, 200.0, 250.0, {-35.71857858047681, -29.415300007451247, 408.4758390487544},
+      {Lobe::kOuter,
+       200.0,
+       250.0,
+       {-35.71857858047681, -29.415300007451247, 408.4758390487544},
        {-0.6421123864290799, -0.4737610224180848, -0.602695758099991}},
-      {Lobe::kOuter, 514.5, 40.0, {7.682743330406083e-14, -53.71597332848289, 411.9300383348209},
+      {Lobe::kOuter,
+       514.5,
+       40.0,
+       {7.682743330406083e-14, -53.71597332848289, 411.9300383348209},
        {0.021820167078413725, -0.9248920890056535, -0.37960308745244503}},
   };
   const RigModel rig(perturbed_config());

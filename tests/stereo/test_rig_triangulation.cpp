@@ -28,7 +28,8 @@ TEST_CASE("row triangulator: a designed rig's column-aware path is the closed fo
   }
 }
 
-TEST_CASE("row triangulator: a misaligned rig triangulates floor points from their designed rows", "[stereo][rig]") {
+TEST_CASE("row triangulator: a misaligned rig triangulates floor points from their designed rows",
+          "[stereo][rig]") {
   // The panorama of a misaligned rig keeps floor points on their designed rows
   // (panorama_maps.hpp), so the designed rows of a floor point must triangulate back to it
   // through the real rays; fractional rows interpolate the maps linearly.
@@ -50,7 +51,8 @@ TEST_CASE("row triangulator: a misaligned rig triangulates floor points from the
       REQUIRE(inner);
       REQUIRE(outer);
       CAPTURE(column, range_m, *inner, *outer);
-      const auto point = triangulator.triangulate(column, static_cast<float>(*inner), static_cast<float>(*outer));
+      const auto point =
+          triangulator.triangulate(column, static_cast<float>(*inner), static_cast<float>(*outer));
       REQUIRE(point);
       // float rows and maps, linear interpolation between rows: measured up to 8 um.
       CHECK(std::abs(point->range_m - range_m) < 1e-5 * range_m);

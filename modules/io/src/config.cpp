@@ -20,7 +20,8 @@ void read_degradation(YamlSection &section, degrade::DegradationConfig &config);
 namespace {
 
 // A pair `key: [x, y]` of finite numbers, scaled (e.g. degrees to radians).
-void read_pair(YamlSection &section, const char *key, const char *expected, double scale, double &x, double &y) {
+void read_pair(YamlSection &section, const char *key, const char *expected, double scale, double &x,
+               double &y) {
   if (!section.has(key)) return;
   const YAML::Node pair = section.node(key);
   if (!pair.IsSequence() || pair.size() != 2) section.fail(key, expected);
@@ -45,9 +46,11 @@ void read_rig_fields(YamlSection &section, mirror::RigConfig &rig) {
             rig.mirror_tilt_y_rad);
   read_pair(section, "mirror_offset_mm", "must be [x, y] in millimetres", 1.0, rig.mirror_offset_x_mm,
             rig.mirror_offset_y_mm);
-  if (!(rig.focal_scale >= 0.9 && rig.focal_scale <= 1.1)) section.fail("focal_scale", "must be in [0.9, 1.1]");
+  if (!(rig.focal_scale >= 0.9 && rig.focal_scale <= 1.1))
+    section.fail("focal_scale", "must be in [0.9, 1.1]");
   if (!(std::abs(rig.mirror_dz_mm) <= kMaxShiftMm)) section.fail("mirror_dz_mm", "must be within +-10 mm");
-  if (!(std::abs(rig.mirror_tilt_x_rad) <= kMaxTiltDeg * kRad && std::abs(rig.mirror_tilt_y_rad) <= kMaxTiltDeg * kRad))
+  if (!(std::abs(rig.mirror_tilt_x_rad) <= kMaxTiltDeg * kRad &&
+        std::abs(rig.mirror_tilt_y_rad) <= kMaxTiltDeg * kRad))
     section.fail("mirror_tilt_deg", "each angle must be within +-5 degrees");
   if (!(std::abs(rig.mirror_offset_x_mm) <= kMaxShiftMm && std::abs(rig.mirror_offset_y_mm) <= kMaxShiftMm))
     section.fail("mirror_offset_mm", "each offset must be within +-10 mm");

@@ -11,7 +11,7 @@ namespace {
 
 constexpr double kMmPerM = 1000.0;
 constexpr double kFarthestReferenceMm = 20000.0;  // rays at or near the horizon: a point this far
-constexpr float kOutsidePx = -10.0f;            // samples black (cv::remap, constant border)
+constexpr float kOutsidePx = -10.0f;              // samples black (cv::remap, constant border)
 // The designed rig samples its extreme rows half a pixel inside the annulus; a quarter pixel
 // keeps every row of a designed (or barely misaligned) rig and only drops rows a moved
 // mirror really takes off the lobe.

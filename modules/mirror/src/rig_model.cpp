@@ -8,9 +8,9 @@ namespace {
 
 constexpr double kMmPerM = 1000.0;
 constexpr int kMaxNewtonSteps = 30;
-constexpr double kSurfaceTolMm = 1e-11;     // Newton step along the camera ray
+constexpr double kSurfaceTolMm = 1e-11;  // Newton step along the camera ray
 constexpr int kMaxGaussNewtonSteps = 20;
-constexpr double kPixelTolPx = 1e-9;        // Gauss-Newton step on the pixel
+constexpr double kPixelTolPx = 1e-9;  // Gauss-Newton step on the pixel
 constexpr double kJacobianStepPx = 1e-4;
 
 // The lobe's meridian profile (mirror.md sec. 2, eq. 2-5) and its gradient in (r, z):
@@ -80,7 +80,8 @@ std::optional<RigModel::MirrorHit> RigModel::hit(Lobe lobe, const Pixel &pixel) 
   const MirrorConfig &config = design_.config();
   const MirrorModel::LobeConstants &k = design_.constants(lobe);
   const Eigen::Vector3d dir_camera =
-      Eigen::Vector3d(pixel.u_px - config.center_u_px, pixel.v_px - config.center_v_px, focal_px_).normalized();
+      Eigen::Vector3d(pixel.u_px - config.center_u_px, pixel.v_px - config.center_v_px, focal_px_)
+          .normalized();
   // The pinhole and the camera ray in the mirror's design frame.
   const Eigen::Vector3d origin = rotation_.transpose() * (-pivot_mm_ - shift_mm_) + pivot_mm_;
   const Eigen::Vector3d dir = rotation_.transpose() * dir_camera;
@@ -138,7 +139,8 @@ std::optional<Pixel> RigModel::project(Lobe lobe, const Eigen::Vector3d &point_m
   const std::optional<double> radius_px = design_.radius_px_of_theta(lobe, theta);
   if (!radius_px) return std::nullopt;
   const double phi = std::atan2(point_m.y(), point_m.x());
-  Eigen::Vector2d uv(config.center_u_px + *radius_px * std::cos(phi), config.center_v_px + *radius_px * std::sin(phi));
+  Eigen::Vector2d uv(config.center_u_px + *radius_px * std::cos(phi),
+                     config.center_v_px + *radius_px * std::sin(phi));
   // Residual: the unit direction from the ray's origin to the point minus the ray's
   // direction (zero when the pixel's ray passes through the point; radians).
   const auto residual = [&](const Eigen::Vector2d &at) -> std::optional<Eigen::Vector3d> {

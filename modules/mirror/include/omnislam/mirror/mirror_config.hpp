@@ -40,8 +40,8 @@ struct RigConfig {
 
   /// True when the rig is exactly as designed (the closed-form model applies).
   [[nodiscard]] bool nominal() const {
-    return focal_scale == 1.0 && mirror_dz_mm == 0.0 && mirror_tilt_x_rad == 0.0 && mirror_tilt_y_rad == 0.0 &&
-           mirror_offset_x_mm == 0.0 && mirror_offset_y_mm == 0.0;
+    return focal_scale == 1.0 && mirror_dz_mm == 0.0 && mirror_tilt_x_rad == 0.0 &&
+           mirror_tilt_y_rad == 0.0 && mirror_offset_x_mm == 0.0 && mirror_offset_y_mm == 0.0;
   }
 };
 

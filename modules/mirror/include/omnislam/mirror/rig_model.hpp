@@ -40,7 +40,7 @@ struct Pixel {
 /// The closest point of two rays and how well they met.
 struct RayIntersection {
   Eigen::Vector3d point_m = Eigen::Vector3d::Zero();  ///< midpoint of the closest approach
-  double gap_m = 0.0;                                  ///< distance between the rays there
+  double gap_m = 0.0;                                 ///< distance between the rays there
 };
 
 class RigModel {
@@ -80,21 +80,21 @@ class RigModel {
 
  private:
   struct MirrorHit {
-    Eigen::Vector3d point_mm;   ///< on the lobe, mirror frame
-    Eigen::Vector3d normal;     ///< unit, mirror frame
-    Eigen::Vector3d ray_dir;    ///< unit camera-ray direction, mirror frame
+    Eigen::Vector3d point_mm;  ///< on the lobe, mirror frame
+    Eigen::Vector3d normal;    ///< unit, mirror frame
+    Eigen::Vector3d ray_dir;   ///< unit camera-ray direction, mirror frame
   };
   [[nodiscard]] std::optional<MirrorHit> hit(Lobe lobe, const Pixel &pixel) const;
 
   MirrorModel design_;
-  Eigen::Matrix3d rotation_;   ///< R: mirror (design) frame -> camera frame
-  Eigen::Vector3d pivot_mm_;   ///< the designed inner focus
-  Eigen::Vector3d shift_mm_;   ///< (offset_x, offset_y, dz)
-  double focal_px_ = 0.0;      ///< true focal length in pixels
+  Eigen::Matrix3d rotation_;  ///< R: mirror (design) frame -> camera frame
+  Eigen::Vector3d pivot_mm_;  ///< the designed inner focus
+  Eigen::Vector3d shift_mm_;  ///< (offset_x, offset_y, dz)
+  double focal_px_ = 0.0;     ///< true focal length in pixels
   struct Extent {
-    double min_mm = 0.0;        ///< mirror radius at the annulus's inner edge
-    double max_mm = 0.0;        ///< and at its outer edge
-    double mm_per_px = 0.0;     ///< mean mirror radius per pixel of image radius
+    double min_mm = 0.0;     ///< mirror radius at the annulus's inner edge
+    double max_mm = 0.0;     ///< and at its outer edge
+    double mm_per_px = 0.0;  ///< mean mirror radius per pixel of image radius
   };
   Extent inner_extent_, outer_extent_;
 };
