@@ -129,6 +129,21 @@ std::optional<double> RigModel::mirror_radius_mm(Lobe lobe, const Pixel &pixel) 
   return std::hypot(h->point_mm.x(), h->point_mm.y());
 }
 
+std::optional<Pixel> RigModel::mirror_edge_pixel(Lobe lobe, double radius_px, double phi_rad) const {
+  const MirrorConfig &config = design_.config();
+  const MirrorModel::LobeConstants &k = design_.constants(lobe);
+  // The designed mirror point of that image radius (mirror.md sec. 2), in the mirror's pose.
+  const double gamma = std::atan(radius_px * config.pixel_pitch_mm / config.focal_mm);
+  const double distance_mm = k.b_mm * k.b_mm / (k.c_mm * std::cos(gamma - k.beta_rad) - k.a_mm);
+  const double r_mm = distance_mm * std::sin(gamma);
+  const Eigen::Vector3d design(r_mm * std::cos(phi_rad), r_mm * std::sin(phi_rad),
+                               distance_mm * std::cos(gamma));
+  const Eigen::Vector3d camera = rotation_ * (design - pivot_mm_) + pivot_mm_ + shift_mm_;
+  if (!(camera.z() > 0.0)) return std::nullopt;
+  return Pixel{config.center_u_px + focal_px_ * camera.x() / camera.z(),
+               config.center_v_px + focal_px_ * camera.y() / camera.z()};
+}
+
 std::optional<Pixel> RigModel::project(Lobe lobe, const Eigen::Vector3d &point_m) const {
   if (!point_m.allFinite()) return std::nullopt;
   const MirrorConfig &config = design_.config();

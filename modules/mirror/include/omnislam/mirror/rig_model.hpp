@@ -73,6 +73,12 @@ class RigModel {
   /// the gap or the housing instead.
   [[nodiscard]] bool sees_lobe(Lobe lobe, const Pixel &pixel, double margin_px = 0.0) const;
 
+  /// The pixel at which the camera sees directly (not in the mirror) the point of the lobe
+  /// that the designed rig images at `radius_px` and azimuth `phi_rad`: at 512 px the
+  /// mirror's rim, at 62 px the edge of the inner lobe's central opening (the circles the
+  /// rim method fits). nullopt when the point is behind the camera.
+  [[nodiscard]] std::optional<Pixel> mirror_edge_pixel(Lobe lobe, double radius_px, double phi_rad) const;
+
   /// Closest approach of the inner and outer rays; nullopt when they are parallel or the
   /// closest point lies behind either ray's origin (the rays do not meet in front of the
   /// mirror, as in mirror.md sec. 6).
