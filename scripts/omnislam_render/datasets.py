@@ -124,8 +124,9 @@ DATASETS: dict[str, DatasetSpec] = {
 }
 
 
-def render_key(room: Room, camera_height_m: float = CAMERA_HEIGHT_M, grey: bool = False) -> str:
-    parts = [RENDERER_VERSION, room.pov_body(), pov.camera_block(), pov.mirror_block(), ANTIALIAS,
+def render_key(room: Room, camera_height_m: float = CAMERA_HEIGHT_M, grey: bool = False,
+               rig: M.Rig = M.Rig()) -> str:
+    parts = [RENDERER_VERSION, room.pov_body(), pov.camera_block(rig), pov.mirror_block(rig), ANTIALIAS,
              repr(camera_height_m)]
     text = "|".join(parts + (["grey"] if grey else []))
     return hashlib.sha256(text.encode()).hexdigest()[:16]
@@ -135,14 +136,14 @@ def _fmt(x: float) -> str:
     return repr(float(x))
 
 
-def dataset_yaml(spec: DatasetSpec, frames: int, origin: Pose, key: str) -> str:
+def dataset_yaml(spec: DatasetSpec, frames: int, origin: Pose, key: str, rig: M.Rig = M.Rig()) -> str:
     return (
         f"# omnislam dataset rendered by scripts/render-dataset (POV-Ray): {spec.description}\n"
         f"# renderer: room {spec.room().name}, render key {key}, "
         f"map origin in room frame: x={_fmt(origin[0])} y={_fmt(origin[1])} yaw={_fmt(origin[2])}\n"
         f"name: {spec.name}\n"
-        f"camera: {{width: {M.IMAGE_PX}, height: {M.IMAGE_PX}, center_px: [{M.CENTER_PX}, {M.CENTER_PX}], "
-        f"focal_mm: {M.FOCAL_MM}, pixel_pitch_mm: {_fmt(M.PIXEL_MM)}}}\n"
+        f"camera: {{width: {M.IMAGE_PX}, height: {M.IMAGE_PX}, center_px: [{rig.center_px[0]}, {rig.center_px[1]}], "
+        f"focal_mm: {M.FOCAL_MM}, pixel_pitch_mm: {_fmt(M.PIXEL_MM)}{rig.yaml_fields()}}}\n"
         "mirror: thesis-2008          # mirror.md, derived constants\n"
         f"camera_height_m: {spec.camera_height_m}         # height of the camera pinhole F0 above the floor\n"
         f"frames: {frames}\n"
@@ -166,7 +167,7 @@ def write_floorplan(path: Path, room: Room, origin: Pose) -> None:
     path.write_text("\n".join(lines) + "\n")
 
 
-def write_metadata(spec: DatasetSpec, out: Path, frames: int | None = None) -> list[Pose]:
+def write_metadata(spec: DatasetSpec, out: Path, frames: int | None = None, rig: M.Rig = M.Rig()) -> list[Pose]:
     """Everything but the images; returns the world poses of the frames written."""
     world = spec.world_poses()
     if frames is not None:
@@ -187,8 +188,8 @@ def write_metadata(spec: DatasetSpec, out: Path, frames: int | None = None) -> l
     elif (out / "odometry.txt").exists():
         (out / "odometry.txt").unlink()
     write_floorplan(out / "floorplan.csv", room, origin)
-    key = render_key(room, spec.camera_height_m, spec.grey)
-    (out / "dataset.yaml").write_text(dataset_yaml(spec, len(world), origin, key))
+    key = render_key(room, spec.camera_height_m, spec.grey, rig)
+    (out / "dataset.yaml").write_text(dataset_yaml(spec, len(world), origin, key, rig))
     return world
 
 
@@ -234,9 +235,9 @@ def _link_or_copy(src: Path, dst: Path) -> None:
 
 
 def render_images(spec: DatasetSpec, out: Path, world: Sequence[Pose], threads: int = 2,
-                  log=print) -> dict:
+                  log=print, rig: M.Rig = M.Rig()) -> dict:
     room = spec.room()
-    key = render_key(room, spec.camera_height_m, spec.grey)
+    key = render_key(room, spec.camera_height_m, spec.grey, rig)
     images = out / "images"
     images.mkdir(parents=True, exist_ok=True)
     for stale in images.glob("*.png"):
@@ -244,7 +245,7 @@ def render_images(spec: DatasetSpec, out: Path, world: Sequence[Pose], threads: 
             stale.unlink()
     reuse = _reusable_images(out, key)
     done: dict[tuple, Path] = {}
-    camera, mirror = pov.camera_block(), pov.mirror_block()
+    camera, mirror = pov.camera_block(rig), pov.mirror_block(rig)
     times, reused = [], 0
     with tempfile.TemporaryDirectory(prefix=f"omnislam-{spec.name}-") as tmp:
         for i, pose in enumerate(world, start=1):
@@ -268,12 +269,14 @@ def render_images(spec: DatasetSpec, out: Path, world: Sequence[Pose], threads: 
 
 
 def build(name: str, out: Path, frames: int | None = None, images: bool = True,
-          threads: int = 2, log=print) -> dict:
+          threads: int = 2, log=print, rig: M.Rig = M.Rig()) -> dict:
+    """Renders dataset `name` into `out`; `rig` is the assembled rig the images are taken
+    with (default: the design), written into dataset.yaml so a replay uses the true rig."""
     spec = DATASETS[name]
     t0 = time.monotonic()
-    world = write_metadata(spec, out, frames)
+    world = write_metadata(spec, out, frames, rig)
     stats = {"frames": len(world)}
     if images:
-        stats.update(render_images(spec, out, world, threads=threads, log=log))
+        stats.update(render_images(spec, out, world, threads=threads, log=log, rig=rig))
     stats["seconds"] = time.monotonic() - t0
     return stats

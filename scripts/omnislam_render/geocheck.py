@@ -74,3 +74,62 @@ def check(range_mm: float = 40000.0) -> dict:
                           "mean_px": float(err_px.mean()),
                           "max_abs_az_deg": float(np.degrees(np.abs(err_az)).max())}
     return out
+
+
+def rig_check(rig: M.Rig, size: int = 128, range_mm: float = 20000.0,
+              trace_rigs: tuple[M.Rig, ...] | None = None) -> list[dict]:
+    """The renderer against mirror.trace for an assembled rig (issue 12): a floor plane
+    carries 16-bit ramps of x and y; at each pixel whose centre is 3 px inside a lobe's
+    designed annulus, the rendered floor point is compared with the traced ray's floor
+    point, the error converted to image pixels through the local floor-per-pixel Jacobian.
+    Renders at size x size (each pixel covers 1024/size design pixels at their centre).
+    One result per rig of `trace_rigs` (default: the rendered rig alone)."""
+    def scene(function: str) -> str:
+        return ("#version 3.7;\nglobal_settings { assumed_gamma 1.0 max_trace_level 5 }\n"
+                f"plane {{ z, {FLOOR_Z_MM} pigment {{ function {{ {function} }} "
+                "color_map { [0 rgb 0][1 rgb 1] } } finish { ambient 1 diffuse 0 } }\n"
+                + pov.camera_block(rig) + pov.mirror_block(rig))
+
+    images = {}
+    with tempfile.TemporaryDirectory(prefix="omnislam-rig-") as tmp:
+        for axis in ("x", "y"):
+            pov_file, ppm = Path(tmp) / f"{axis}.pov", Path(tmp) / f"{axis}.ppm"
+            pov_file.write_text(scene(f"{axis}/{2 * range_mm!r}+0.5"))
+            subprocess.run([pov.povray_binary(), f"+I{pov_file}", f"+O{ppm}", f"+W{size}", f"+H{size}",
+                            "+FP16", "File_Gamma=1.0", "-D", "-V", "+WT2", "-A"],
+                           check=True, capture_output=True)
+            images[axis] = (read_ppm(ppm)[..., 0].astype(float) / 65535.0 - 0.5) * 2 * range_mm
+    return [_compare_floor(images, trace_rig, size, range_mm) for trace_rig in (trace_rigs or (rig,))]
+
+
+def _compare_floor(images: dict, rig: M.Rig, size: int, range_mm: float) -> dict:
+    scale = M.IMAGE_PX / size
+    out = {}
+    for lobe, lo, hi in ((M.INNER, M.R_CENTRAL_PX + 3, M.R_SPLIT_PX - 3),
+                         (M.OUTER, M.R_SPLIT_PX + 3, M.R_RIM_PX - 3)):
+        errors = []
+        for row in range(size):
+            for col in range(size):
+                u, v = (col + 0.5) * scale - 0.5, (row + 0.5) * scale - 0.5
+                radius = math.hypot(u - M.CENTER_PX, v - M.CENTER_PX)
+                if not lo < radius < hi:
+                    continue
+                rays = [M.trace(lobe, u + du, v + dv, rig) for du, dv in ((0.0, 0.0), (0.5, 0.0), (0.0, 0.5))]
+                if any(r is None or r[1][2] >= 0 for r in rays):
+                    continue
+                floor = []
+                for origin, direction in rays:
+                    t = (FLOOR_Z_MM - origin[2]) / direction[2]
+                    floor.append((origin[0] + t * direction[0], origin[1] + t * direction[1]))
+                if math.hypot(*floor[0]) > 0.9 * range_mm:
+                    continue
+                # The floor error in image pixels: solve J delta = error, J = d floor / d pixel.
+                j = [[(floor[1][0] - floor[0][0]) / 0.5, (floor[2][0] - floor[0][0]) / 0.5],
+                     [(floor[1][1] - floor[0][1]) / 0.5, (floor[2][1] - floor[0][1]) / 0.5]]
+                det = j[0][0] * j[1][1] - j[0][1] * j[1][0]
+                ex, ey = images["x"][row, col] - floor[0][0], images["y"][row, col] - floor[0][1]
+                errors.append(math.hypot(j[1][1] * ex - j[0][1] * ey, -j[1][0] * ex + j[0][0] * ey) / abs(det))
+        errors.sort()
+        out[lobe.name] = {"pixels": len(errors), "median_px": errors[len(errors) // 2],
+                          "p95_px": errors[int(0.95 * len(errors))]}
+    return out

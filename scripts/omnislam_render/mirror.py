@@ -137,3 +137,119 @@ def surface_polynomial(lobe: Lobe, z_ref: float, scale: float = 1.0) -> Poly:
 
 def eval_poly(p: Poly, x: float, y: float, w: float) -> float:
     return sum(v * x ** i * y ** j * w ** k for (i, j, k), v in p.items())
+
+
+# --- a real rig: the camera and mirror as assembled (issue 12) ----------------
+@dataclass(frozen=True)
+class Rig:
+    """Misalignments of an assembled rig, with the meaning of the C++ RigConfig
+    (modules/mirror/include/omnislam/mirror/mirror_config.hpp) and the same config keys:
+    the mirror (both lobes, rigid) is placed in the camera frame by
+        p_camera = R (p_design - pivot) + pivot + (offset_x, offset_y, dz),
+        R = Ry(tilt_y) Rx(tilt_x),  pivot = (0, 0, z of the inner focus),
+    the true focal length is focal_scale * FOCAL_MM and the optical axis is at center_px.
+    The defaults are the design."""
+    focal_scale: float = 1.0
+    mirror_dz_mm: float = 0.0
+    tilt_deg: tuple[float, float] = (0.0, 0.0)
+    offset_mm: tuple[float, float] = (0.0, 0.0)
+    center_px: tuple[float, float] = (CENTER_PX, CENTER_PX)
+
+    def nominal(self) -> bool:
+        return self == Rig()
+
+    def mirror_moved(self) -> bool:
+        return (self.mirror_dz_mm, self.tilt_deg, self.offset_mm) != (0.0, (0.0, 0.0), (0.0, 0.0))
+
+    @property
+    def pivot(self) -> tuple[float, float, float]:
+        return (0.0, 0.0, INNER.z_focus)
+
+    def rotation(self) -> list[list[float]]:
+        """R = Ry(tilt_y) Rx(tilt_x), rows."""
+        ax, ay = (math.radians(a) for a in self.tilt_deg)
+        cx, sx, cy, sy = math.cos(ax), math.sin(ax), math.cos(ay), math.sin(ay)
+        rx = [[1.0, 0.0, 0.0], [0.0, cx, -sx], [0.0, sx, cx]]
+        ry = [[cy, 0.0, sy], [0.0, 1.0, 0.0], [-sy, 0.0, cy]]
+        return [[sum(ry[i][k] * rx[k][j] for k in range(3)) for j in range(3)] for i in range(3)]
+
+    def translation(self) -> tuple[float, float, float]:
+        """t in p_camera = R p_design + t."""
+        r, p = self.rotation(), self.pivot
+        shift = (self.offset_mm[0], self.offset_mm[1], self.mirror_dz_mm)
+        return tuple(p[i] + shift[i] - sum(r[i][k] * p[k] for k in range(3)) for i in range(3))
+
+    def to_camera(self, p: tuple[float, float, float]) -> tuple[float, float, float]:
+        r, t = self.rotation(), self.translation()
+        return tuple(sum(r[i][k] * p[k] for k in range(3)) + t[i] for i in range(3))
+
+    def to_design(self, p: tuple[float, float, float]) -> tuple[float, float, float]:
+        r, t = self.rotation(), self.translation()
+        q = [p[i] - t[i] for i in range(3)]
+        return tuple(sum(r[k][i] * q[k] for k in range(3)) for i in range(3))
+
+    def yaml_fields(self) -> str:
+        """The camera keys of this rig for dataset.yaml / a config (empty when nominal)."""
+        out = ""
+        if self.focal_scale != 1.0:
+            out += f", focal_scale: {self.focal_scale!r}"
+        if self.mirror_dz_mm != 0.0:
+            out += f", mirror_dz_mm: {self.mirror_dz_mm!r}"
+        if self.tilt_deg != (0.0, 0.0):
+            out += f", mirror_tilt_deg: [{self.tilt_deg[0]!r}, {self.tilt_deg[1]!r}]"
+        if self.offset_mm != (0.0, 0.0):
+            out += f", mirror_offset_mm: [{self.offset_mm[0]!r}, {self.offset_mm[1]!r}]"
+        return out
+
+
+def trace(lobe: Lobe, u_px: float, v_px: float, rig: Rig = Rig()):
+    """The world ray of image pixel (u, v) through `lobe` of `rig`, traced explicitly
+    (camera ray, the lobe's implicit profile in the mirror's pose, law of reflection):
+    ((origin), (unit direction)) in camera-frame mm, or None when the ray misses.
+    Bisection on the profile between the lobe's vertex side and its rim side, so it
+    shares no iteration with the C++ model's Newton steps."""
+    d_cam = ((u_px - rig.center_px[0]) * PIXEL_MM, (v_px - rig.center_px[1]) * PIXEL_MM,
+             FOCAL_MM * rig.focal_scale)
+    n = math.sqrt(sum(c * c for c in d_cam))
+    d_cam = tuple(c / n for c in d_cam)
+    o = rig.to_design((0.0, 0.0, 0.0))
+    far = rig.to_design(d_cam)
+    d = tuple(far[i] - o[i] for i in range(3))
+
+    def g(t: float) -> float:
+        p = [o[i] + t * d[i] for i in range(3)]
+        return lobe.profile_value(math.hypot(p[0], p[1]), p[2])
+
+    # From the pinhole the camera ray crosses the hyperboloid's near sheet (g turns < 0 at
+    # about c - a) and then the mirror sheet (g > 0 again) once before 2.2 c.
+    lo, hi = lobe.c, 2.2 * lobe.c
+    if g(lo) * g(hi) > 0.0:
+        return None
+    for _ in range(200):
+        mid = 0.5 * (lo + hi)
+        if g(lo) * g(mid) <= 0.0:
+            hi = mid
+        else:
+            lo = mid
+    t = 0.5 * (lo + hi)
+    p = [o[i] + t * d[i] for i in range(3)]
+    # Normal: numerical gradient of the profile revolved about the mirror axis.
+    h = 1e-6
+
+    def f(q):
+        return lobe.profile_value(math.hypot(q[0], q[1]), q[2])
+    grad = []
+    for i in range(3):
+        qp, qm = list(p), list(p)
+        qp[i] += h
+        qm[i] -= h
+        grad.append((f(qp) - f(qm)) / (2 * h))
+    gn = math.sqrt(sum(c * c for c in grad))
+    nrm = [c / gn for c in grad]
+    dot = sum(d[i] * nrm[i] for i in range(3))
+    refl = [d[i] - 2.0 * dot * nrm[i] for i in range(3)]
+    origin = rig.to_camera(tuple(p))
+    zero = rig.to_camera((0.0, 0.0, 0.0))
+    tip = rig.to_camera(tuple(refl))
+    direction = tuple(tip[i] - zero[i] for i in range(3))
+    return origin, direction

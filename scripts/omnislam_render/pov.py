@@ -32,14 +32,27 @@ def vec(*xs: float) -> str:
     return "<" + ", ".join(num(x) for x in xs) + ">"
 
 
-def camera_block() -> str:
+def camera_block(rig: M.Rig = M.Rig()) -> str:
     half = M.RHO_MAX_MM * M.IMAGE_PX / 1024.0  # half the sensor width: 512 px
     width = 2.0 * half
+    # POV-Ray's ray for image point (sx, sy) in [-1/2, 1/2] is direction + sx right + sy up,
+    # so pixel u sees direction + (u - 511.5) pitch x: moving `direction` off the image
+    # centre puts the optical axis at rig.center_px, and its length is the focal length.
+    du = (M.CENTER_PX - rig.center_px[0]) * M.PIXEL_MM
+    dv = (M.CENTER_PX - rig.center_px[1]) * M.PIXEL_MM
     return (
         "// Pinhole F0 at the origin looking up (+z); image u -> +x, v -> +y.\n"
-        f"camera {{ perspective location <0,0,0> direction {vec(0, 0, M.FOCAL_MM)}\n"
+        f"camera {{ perspective location <0,0,0> direction {vec(du, dv, M.FOCAL_MM * rig.focal_scale)}\n"
         f"         right {vec(width, 0, 0)} up {vec(0, -width, 0)} }}\n"
     )
+
+
+def rig_transform(rig: M.Rig) -> str:
+    """The mirror's pose as a POV-Ray matrix (p' = p M with p a row vector: the rows of M
+    are the images of the axes, i.e. the columns of R, then the translation)."""
+    r, t = rig.rotation(), rig.translation()
+    entries = [r[j][i] for i in range(3) for j in range(3)] + list(t)
+    return "matrix <" + ", ".join(num(x) for x in entries) + ">"
 
 
 def _polynomial(poly: dict) -> str:
@@ -76,15 +89,22 @@ def _lobe_block(lobe: M.Lobe, r_in_px: float, r_out_px: float) -> str:
     )
 
 
-def mirror_block() -> str:
+def mirror_block(rig: M.Rig = M.Rig()) -> str:
+    body = (
+        _lobe_block(M.INNER, M.R_CENTRAL_PX, M.R_SPLIT_PX)
+        + _lobe_block(M.OUTER, M.R_SPLIT_PX, M.R_RIM_PX)
+        + "// Black cap above the mirror: camera rays that miss both lobes end here.\n"
+        "disc { <0,0,440>, -z, 400 pigment { rgb 0 } finish { ambient 0 diffuse 0 } no_shadow }\n"
+    )
+    if rig.mirror_moved():
+        # The lobes are cut (clipped) in the mirror's own frame, so the whole part moves.
+        body = ("// The mirror as mounted: tilted and shifted (issue 12, mirror.Rig).\n"
+                "union {\n" + body + f"  {rig_transform(rig)}\n}}\n")
     return (
         "// Double-lobed mirror (mirror.md), perfect reflector, exact implicit surfaces.\n"
         "#declare Mirror_Finish = texture { pigment { rgb 0 }\n"
         "  finish { ambient 0 diffuse 0 specular 0 phong 0 reflection { 1 } } }\n"
-        + _lobe_block(M.INNER, M.R_CENTRAL_PX, M.R_SPLIT_PX)
-        + _lobe_block(M.OUTER, M.R_SPLIT_PX, M.R_RIM_PX)
-        + "// Black cap above the mirror: camera rays that miss both lobes end here.\n"
-        "disc { <0,0,440>, -z, 400 pigment { rgb 0 } finish { ambient 0 diffuse 0 } no_shadow }\n"
+        + body
     )
 
 

@@ -1,5 +1,6 @@
 #include <catch2/catch.hpp>
 #include <cmath>
+#include <numbers>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <string>
@@ -93,4 +94,54 @@ TEST_CASE("rim method: a black image, a featureless one and a wrong type say why
   CHECK_FALSE(find_rim(noise, camera).ok());
   CHECK_FALSE(find_rim(cv::Mat(1024, 1024, CV_8UC3, cv::Scalar(0, 0, 0)), camera).ok());
   CHECK_FALSE(find_rim(cv::Mat(), camera).ok());
+}
+
+// datasets/sim-room-37-rig: the mirror tilted 0.8 / -0.5 deg and offset 0.7 / -0.4 mm, the
+// optical axis at (514.0, 509.5). Its rim and central disc are ~12 and ~14 px off that axis
+// (measured fits: (508.38, 487.50) and (524.90, 506.08)); the configured rig predicts them.
+TEST_CASE("rim method on a tilted and offset mirror: the circles where the rig puts them, the axis recovered",
+          "[calib][rim][rig]") {
+  omnislam::mirror::MirrorConfig camera;
+  camera.rig.focal_scale = 1.008;
+  camera.rig.mirror_dz_mm = 2.5;
+  camera.rig.mirror_tilt_x_rad = 0.8 * std::numbers::pi / 180.0;
+  camera.rig.mirror_tilt_y_rad = -0.5 * std::numbers::pi / 180.0;
+  camera.rig.mirror_offset_x_mm = 0.7;
+  camera.rig.mirror_offset_y_mm = -0.4;
+  const cv::Mat image = frame("sim-room-37-rig", 1);
+  for (const double u : {514.0, 511.5}) {  // the true centre configured, and 3.2 px off it
+    camera.center_u_px = u;
+    camera.center_v_px = u == 514.0 ? 509.5 : 511.5;
+    CAPTURE(camera.center_u_px, camera.center_v_px);
+    const auto estimate = find_rim(image, camera);
+    REQUIRE(estimate.ok());
+    REQUIRE(estimate.rim);
+    REQUIRE(estimate.central);
+    CHECK(std::abs(estimate.centre_px.x() - 514.0) < 0.05);
+    CHECK(std::abs(estimate.centre_px.y() - 509.5) < 0.05);
+  }
+  camera.center_u_px = 514.0, camera.center_v_px = 509.5;
+  const auto predicted = omnislam::calib::predict_rim(camera);
+  const auto estimate = find_rim(image, camera);
+  CHECK((estimate.rim->centre_px - predicted.rim_centre_px).norm() < 0.05);
+  CHECK((estimate.central->centre_px - predicted.central_centre_px).norm() < 0.05);
+  CHECK((predicted.rim_centre_px - Eigen::Vector2d(514.0, 509.5)).norm() > 10.0);
+  // Read as a designed rig, the same image gives the circles' mean: far from the axis.
+  const auto designed = find_rim(image, omnislam::mirror::MirrorConfig{});
+  REQUIRE(designed.ok());
+  CHECK((designed.centre_px - Eigen::Vector2d(514.0, 509.5)).norm() > 5.0);
+}
+
+TEST_CASE("rim prediction of a designed rig is the configured centre", "[calib][rim][rig]") {
+  omnislam::mirror::MirrorConfig camera;
+  camera.center_u_px = 500.25;
+  const auto predicted = omnislam::calib::predict_rim(camera);
+  CHECK(predicted.rim_centre_px == Eigen::Vector2d(500.25, 511.5));
+  CHECK(predicted.central_centre_px == Eigen::Vector2d(500.25, 511.5));
+  camera.rig.focal_scale = 1.0 + 1e-12;  // the traced path, same answer
+  const auto traced = omnislam::calib::predict_rim(camera);
+  CHECK((traced.rim_centre_px - Eigen::Vector2d(500.25, 511.5)).norm() < 1e-6);
+  CHECK(traced.rim_radius_px == Approx(512.0).epsilon(1e-9));
+  CHECK((traced.central_centre_px - Eigen::Vector2d(500.25, 511.5)).norm() < 1e-6);
+  CHECK(traced.central_radius_px == Approx(62.0).epsilon(1e-9));
 }

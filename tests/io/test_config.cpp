@@ -2,6 +2,7 @@
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <utility>
 
 #include "omnislam/io/config.hpp"
 
@@ -108,6 +109,38 @@ TEST_CASE("config: unknown keys and wrong types name the key and file:line", "[i
   CHECK_THROWS_WITH(omnislam::io::load_config(syntax), Catch::Contains("syntax.yaml:"));
   CHECK_THROWS_WITH(omnislam::io::load_config("/nonexistent/omnislam.yaml"),
                     Catch::Contains("/nonexistent/omnislam.yaml"));
+}
+
+TEST_CASE("config: the rig's misalignments in the camera section, bad values named", "[io][config][rig]") {
+  const fs::path file = write_file("rig.yaml",
+                                   "camera:\n"
+                                   "  focal_scale: 1.008\n"
+                                   "  mirror_dz_mm: 2.5\n"
+                                   "  mirror_tilt_deg: [0.8, -0.5]\n"
+                                   "  mirror_offset_mm: [0.7, -0.4]\n");
+  const omnislam::mirror::RigConfig rig = omnislam::io::load_config(file).scan.camera.rig;
+  CHECK(rig.focal_scale == 1.008);
+  CHECK(rig.mirror_dz_mm == 2.5);
+  CHECK(rig.mirror_tilt_x_rad == Approx(0.8 * 3.14159265358979323846 / 180.0).epsilon(1e-15));
+  CHECK(rig.mirror_tilt_y_rad == Approx(-0.5 * 3.14159265358979323846 / 180.0).epsilon(1e-15));
+  CHECK(rig.mirror_offset_x_mm == 0.7);
+  CHECK(rig.mirror_offset_y_mm == -0.4);
+  CHECK_FALSE(rig.nominal());
+  CHECK(omnislam::io::load_config(write_file("norig.yaml", "camera:\n  width: 1024\n"))
+            .scan.camera.rig.nominal());
+  const std::pair<const char *, const char *> bad[] = {
+      {"camera:\n  focal_scale: 0\n", "camera.focal_scale"},
+      {"camera:\n  mirror_dz_mm: 270\n", "camera.mirror_dz_mm"},
+      {"camera:\n  mirror_tilt_deg: 1.0\n", "camera.mirror_tilt_deg"},
+      {"camera:\n  mirror_tilt_deg: [0, 90]\n", "camera.mirror_tilt_deg"},
+      {"camera:\n  mirror_offset_mm: [0.5, .nan]\n", "camera.mirror_offset_mm"},
+      {"camera:\n  mirror_offset: [0.5, 0]\n", "camera.mirror_offset"},
+  };
+  for (const auto &[text, key] : bad) {
+    CAPTURE(text);
+    CHECK_THROWS_WITH(omnislam::io::load_config(write_file("badrig.yaml", text)),
+                      Catch::Contains("badrig.yaml:2:") && Catch::Contains(key));
+  }
 }
 
 TEST_CASE("config: the degradation section, per factor, with errors naming key and line", "[io][config]") {

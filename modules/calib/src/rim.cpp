@@ -4,7 +4,10 @@
 #include <cmath>
 #include <cstdint>
 #include <numbers>
+#include <utility>
 #include <vector>
+
+#include "omnislam/mirror/rig_model.hpp"
 
 namespace omnislam::calib {
 namespace {
@@ -18,6 +21,8 @@ constexpr double kSideToPx = 5.0;
 // A second pass casts the rays from the first pass's centre, so they cross the circle
 // square on however far the configured centre was off.
 constexpr int kPasses = 2;
+// Points of a predicted circle (the image of a mirror edge: a circle, or nearly one).
+constexpr int kPredictionPoints = 360;
 
 enum class Polarity { kDarkOutside, kDarkInside };
 
@@ -106,19 +111,41 @@ std::optional<CircleFit> find_circle(const cv::Mat &image, Eigen::Vector2d centr
 
 }  // namespace
 
+RimPrediction predict_rim(const mirror::MirrorConfig &camera) {
+  // The lobes' layout in the image (mirror.md sec. 0): the central disc ends where the inner
+  // lobe begins, the rim where the outer lobe ends.
+  const double central_px = camera.discard_px;
+  const double rim_px = camera.discard_px + 2.0 * camera.rows_per_lobe;
+  const Eigen::Vector2d configured(camera.center_u_px, camera.center_v_px);
+  RimPrediction prediction{configured, rim_px, configured, central_px};
+  if (camera.rig.nominal()) return prediction;
+  const mirror::RigModel rig(camera);
+  const auto circle = [&](mirror::Lobe lobe, double radius_px, Eigen::Vector2d &centre, double &radius) {
+    std::vector<Eigen::Vector2d> points;
+    for (int i = 0; i < kPredictionPoints; ++i) {
+      const auto pixel =
+          rig.mirror_edge_pixel(lobe, radius_px, 2.0 * std::numbers::pi * i / kPredictionPoints);
+      if (pixel) points.emplace_back(pixel->u_px, pixel->v_px);
+    }
+    if (const std::optional<CircleFit> fit = fit_circle(points))
+      centre = fit->centre_px, radius = fit->radius_px;
+  };
+  circle(mirror::Lobe::kOuter, rim_px, prediction.rim_centre_px, prediction.rim_radius_px);
+  circle(mirror::Lobe::kInner, central_px, prediction.central_centre_px, prediction.central_radius_px);
+  return prediction;
+}
+
 RimEstimate find_rim(const cv::Mat &image, const mirror::MirrorConfig &camera, const RimConfig &config) {
   RimEstimate estimate;
   if (image.empty() || image.type() != CV_8UC1) {
     estimate.error = "not an 8-bit grey image";
     return estimate;
   }
-  const Eigen::Vector2d nominal(camera.center_u_px, camera.center_v_px);
-  // The lobes' layout in the image (mirror.md sec. 0): the central disc ends where the inner
-  // lobe begins, the rim where the outer lobe ends.
-  const double central_px = camera.discard_px;
-  const double rim_px = camera.discard_px + 2.0 * camera.rows_per_lobe;
-  estimate.rim = find_circle(image, nominal, rim_px, Polarity::kDarkOutside, config);
-  estimate.central = find_circle(image, nominal, central_px, Polarity::kDarkInside, config);
+  const RimPrediction predicted = predict_rim(camera);
+  estimate.rim =
+      find_circle(image, predicted.rim_centre_px, predicted.rim_radius_px, Polarity::kDarkOutside, config);
+  estimate.central = find_circle(image, predicted.central_centre_px, predicted.central_radius_px,
+                                 Polarity::kDarkInside, config);
   if (!estimate.rim && !estimate.central) {
     estimate.error = "no mirror rim and no central disc found (a dark step on too few of " +
                      std::to_string(config.rays) + " radial profiles)";
@@ -135,6 +162,22 @@ RimEstimate find_rim(const cv::Mat &image, const mirror::MirrorConfig &camera, c
   }
   estimate.centre_px = weighted.cwiseQuotient(weights);
   estimate.centre_sigma_px = weights.cwiseInverse().cwiseSqrt();
+  if (!camera.rig.nominal()) {
+    // A centre error shifts both circles alike (to first order); their offsets from where
+    // the configured rig puts them are the centre's error.
+    Eigen::Vector2d offset = Eigen::Vector2d::Zero(), offset_weights = Eigen::Vector2d::Zero();
+    const std::pair<const std::optional<CircleFit> *, Eigen::Vector2d> circles[] = {
+        {&estimate.rim, predicted.rim_centre_px}, {&estimate.central, predicted.central_centre_px}};
+    for (const auto &[circle, expected] : circles) {
+      if (!*circle) continue;
+      const Eigen::Vector2d sigma = (*circle)->centre_sigma_px.cwiseMax(1e-6);
+      const Eigen::Vector2d weight = sigma.cwiseProduct(sigma).cwiseInverse();
+      offset += weight.cwiseProduct((*circle)->centre_px - expected);
+      offset_weights += weight;
+    }
+    estimate.centre_px =
+        Eigen::Vector2d(camera.center_u_px, camera.center_v_px) + offset.cwiseQuotient(offset_weights);
+  }
   return estimate;
 }
 

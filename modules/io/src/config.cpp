@@ -1,5 +1,6 @@
 #include "omnislam/io/config.hpp"
 
+#include <cmath>
 #include <initializer_list>
 #include <numbers>
 #include <string>
@@ -16,6 +17,47 @@ void read_service_sections(YamlSection &top, ServiceConfig &service);
 // The image degradation (degradation_section.cpp).
 void read_degradation(YamlSection &section, degrade::DegradationConfig &config);
 
+namespace {
+
+// A pair `key: [x, y]` of finite numbers, scaled (e.g. degrees to radians).
+void read_pair(YamlSection &section, const char *key, const char *expected, double scale, double &x,
+               double &y) {
+  if (!section.has(key)) return;
+  const YAML::Node pair = section.node(key);
+  if (!pair.IsSequence() || pair.size() != 2) section.fail(key, expected);
+  try {
+    x = pair[0].as<double>() * scale;
+    y = pair[1].as<double>() * scale;
+  } catch (const YAML::Exception &) {
+    section.fail(key, expected);
+  }
+  if (!std::isfinite(x) || !std::isfinite(y)) section.fail(key, expected);
+}
+
+// The rig's misalignments (issue 12); the bounds keep the general model's iterations,
+// which start from the designed rig, in their basin and reject unit mistakes (mm for m).
+void read_rig_fields(YamlSection &section, mirror::RigConfig &rig) {
+  constexpr double kMaxShiftMm = 10.0;
+  constexpr double kMaxTiltDeg = 5.0;
+  constexpr double kRad = std::numbers::pi / 180.0;
+  section.read("focal_scale", rig.focal_scale);
+  section.read("mirror_dz_mm", rig.mirror_dz_mm);
+  read_pair(section, "mirror_tilt_deg", "must be [x, y] in degrees", kRad, rig.mirror_tilt_x_rad,
+            rig.mirror_tilt_y_rad);
+  read_pair(section, "mirror_offset_mm", "must be [x, y] in millimetres", 1.0, rig.mirror_offset_x_mm,
+            rig.mirror_offset_y_mm);
+  if (!(rig.focal_scale >= 0.9 && rig.focal_scale <= 1.1))
+    section.fail("focal_scale", "must be in [0.9, 1.1]");
+  if (!(std::abs(rig.mirror_dz_mm) <= kMaxShiftMm)) section.fail("mirror_dz_mm", "must be within +-10 mm");
+  if (!(std::abs(rig.mirror_tilt_x_rad) <= kMaxTiltDeg * kRad &&
+        std::abs(rig.mirror_tilt_y_rad) <= kMaxTiltDeg * kRad))
+    section.fail("mirror_tilt_deg", "each angle must be within +-5 degrees");
+  if (!(std::abs(rig.mirror_offset_x_mm) <= kMaxShiftMm && std::abs(rig.mirror_offset_y_mm) <= kMaxShiftMm))
+    section.fail("mirror_offset_mm", "each offset must be within +-10 mm");
+}
+
+}  // namespace
+
 void read_camera_fields(YamlSection &section, mirror::MirrorConfig &camera) {
   section.read("width", camera.image_width_px);
   section.read("height", camera.image_height_px);
@@ -27,6 +69,7 @@ void read_camera_fields(YamlSection &section, mirror::MirrorConfig &camera) {
   if (camera.image_height_px <= 0) section.fail("height", "must be positive");
   if (!(camera.focal_mm > 0.0)) section.fail("focal_mm", "must be positive");
   if (!(camera.pixel_pitch_mm > 0.0)) section.fail("pixel_pitch_mm", "must be positive");
+  read_rig_fields(section, camera.rig);
 }
 
 }  // namespace detail

@@ -346,7 +346,7 @@ BoundaryStats FloorBoundaryFinder::find(const FloorGeometry &geometry, const cv:
         continue;
       }
       if (match != nullptr) {
-        const auto stereo = triangulator.triangulate(edge.row_subpx, match->row_subpx);
+        const auto stereo = triangulator.triangulate(column, edge.row_subpx, match->row_subpx);
         if (!stereo) continue;
         ++stats.elevated;
         points.push_back({column, edge.row_subpx, match->row_subpx, stereo->range_m, stereo->height_m});
@@ -392,7 +392,7 @@ BoundaryStats FloorBoundaryFinder::find(const FloorGeometry &geometry, const cv:
       const auto range_m = static_cast<float>(geometry_->floor_range_at(base->row_subpx));
       BoundaryPoint point{column, base->row_subpx, outer_row, range_m, floor_height_m};
       if (!config_.floor_plane_range) {
-        const auto stereo = triangulator.triangulate(base->row_subpx, outer_row);
+        const auto stereo = triangulator.triangulate(column, base->row_subpx, outer_row);
         if (!stereo) continue;
         point.range_m = stereo->range_m;
         point.height_m = stereo->height_m;
@@ -409,7 +409,7 @@ BoundaryStats FloorBoundaryFinder::find(const FloorGeometry &geometry, const cv:
             elevated_match(high, column, inner_edges, outer_edges, outer_edges_here, limits, window,
                            geometry_->vertical_outer_row_at(high.row, base->row_subpx), outer_row);
         if (high_match == nullptr) continue;
-        const auto stereo = triangulator.triangulate(high.row_subpx, high_match->row_subpx);
+        const auto stereo = triangulator.triangulate(column, high.row_subpx, high_match->row_subpx);
         if (stereo && stereo->range_m < point.range_m) {
           ++stats.elevated;
           point = {column, high.row_subpx, high_match->row_subpx, stereo->range_m, stereo->height_m};

@@ -1,5 +1,6 @@
 #include "omnislam/stereo/row_triangulator.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstddef>
 
@@ -26,6 +27,38 @@ RowTriangulator::RowTriangulator(const mirror::MirrorModel &model, Triangulation
       theta_inner_(theta_table(model, mirror::Lobe::kInner, rows_)),
       theta_outer_(theta_table(model, mirror::Lobe::kOuter, rows_)) {
   if (method == TriangulationMethod::kTable) table_.emplace(model);
+  if (!model.config().rig.nominal()) {
+    rig_.emplace(Rig{mirror::RigModel(model.config()), mirror::make_panorama_map(model, mirror::Lobe::kInner),
+                     mirror::make_panorama_map(model, mirror::Lobe::kOuter)});
+  }
+}
+
+std::optional<mirror::Ray3> RowTriangulator::rig_ray(mirror::Lobe lobe, int column, float row) const {
+  const mirror::PanoramaMap &map = lobe == mirror::Lobe::kInner ? rig_->inner : rig_->outer;
+  if (column < 0 || column >= map.columns) return std::nullopt;
+  // The panorama interpolates its integer rows linearly, so a fractional row is the same
+  // blend of their image positions.
+  const int below = std::clamp(static_cast<int>(std::floor(row)), 0, map.rows - 2);
+  const double fraction = static_cast<double>(row) - below;
+  const auto at = [&](const std::vector<float> &values, int r) {
+    return static_cast<double>(values[static_cast<std::size_t>(r) * map.columns + column]);
+  };
+  const double u = at(map.u_px, below) + fraction * (at(map.u_px, below + 1) - at(map.u_px, below));
+  const double v = at(map.v_px, below) + fraction * (at(map.v_px, below + 1) - at(map.v_px, below));
+  return rig_->model.back_project(lobe, {u, v});
+}
+
+std::optional<mirror::MeridianPoint> RowTriangulator::triangulate(int column, float inner_row,
+                                                                  float outer_row) const {
+  if (!rig_) return triangulate(inner_row, outer_row);
+  const auto inside = [this](float row) { return row >= -0.5f && row <= static_cast<float>(rows_) - 0.5f; };
+  if (!inside(inner_row) || !inside(outer_row)) return std::nullopt;
+  const std::optional<mirror::Ray3> inner = rig_ray(mirror::Lobe::kInner, column, inner_row);
+  const std::optional<mirror::Ray3> outer = rig_ray(mirror::Lobe::kOuter, column, outer_row);
+  if (!inner || !outer) return std::nullopt;
+  const std::optional<mirror::RayIntersection> meet = mirror::RigModel::intersect(*inner, *outer);
+  if (!meet) return std::nullopt;
+  return mirror::MeridianPoint{std::hypot(meet->point_m.x(), meet->point_m.y()), meet->point_m.z()};
 }
 
 double RowTriangulator::theta_of_row(mirror::Lobe lobe, float row) const {

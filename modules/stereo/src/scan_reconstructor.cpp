@@ -12,6 +12,12 @@
 namespace omnislam::stereo {
 namespace {
 
+// The panorama maps of a misaligned rig resample onto the floor (panorama_maps.hpp).
+mirror::MirrorConfig with_floor_reference(mirror::MirrorConfig camera, double camera_height_m) {
+  camera.reference_depth_mm = camera_height_m * 1000.0;
+  return camera;
+}
+
 constexpr double kTwoPi = 2.0 * std::numbers::pi;
 constexpr int kDegreeBins = 360;
 
@@ -53,7 +59,7 @@ int keep_nearest_per_degree(std::vector<ScanPoint> &points, std::vector<ScanPoin
 
 ScanReconstructor::ScanReconstructor(const ScanConfig &config)
     : config_(config),
-      model_(config.camera),
+      model_(with_floor_reference(config.camera, config.camera_height_m)),
       unwarper_(model_),
       limits_(derive_disparity_limits(model_, config.camera_height_m, config.stereo.min_range_m,
                                       config.stereo.max_range_m, config.stereo.disparity_margin_px)),
@@ -189,7 +195,7 @@ void ScanReconstructor::build_scan(const std::vector<RowMatch> &matches, LocalSc
   scan.points.clear();
   scan.free_range_m.clear();
   for (const RowMatch &match : matches) {
-    const auto point = triangulator_.triangulate(match.inner_row, match.outer_row);
+    const auto point = triangulator_.triangulate(match.column, match.inner_row, match.outer_row);
     if (!point) {
       ++scan.stats.no_intersection;
       continue;

@@ -41,8 +41,22 @@ struct RimEstimate {
   [[nodiscard]] bool ok() const { return error.empty(); }
 };
 
-/// Finds both circles in an 8-bit grey image of the rig described by `camera` (its centre
-/// is where the search starts; the expected radii follow from its lobe layout).
+/// Where the rig described by `camera` shows the two circles: the images (seen directly)
+/// of the mirror's rim and of the inner lobe's central opening, each fitted with a circle.
+/// Both centres are the configured centre for a designed rig; a tilted or offset mirror
+/// moves them apart (e.g. 0.8 deg and 0.7 mm: by ~12 and ~14 px).
+struct RimPrediction {
+  Eigen::Vector2d rim_centre_px = Eigen::Vector2d::Zero();
+  double rim_radius_px = 0.0;
+  Eigen::Vector2d central_centre_px = Eigen::Vector2d::Zero();
+  double central_radius_px = 0.0;
+};
+[[nodiscard]] RimPrediction predict_rim(const mirror::MirrorConfig &camera);
+
+/// Finds both circles in an 8-bit grey image of the rig described by `camera` (the search
+/// starts at their predicted places). The centre estimated is the optical axis: the
+/// configured centre moved by the (inverse-variance mean) offset of the circles found from
+/// where the configured rig puts them (for a designed rig, simply their mean centre).
 [[nodiscard]] RimEstimate find_rim(const cv::Mat &image, const mirror::MirrorConfig &camera,
                                    const RimConfig &config = {});
 

@@ -15,7 +15,8 @@
 ///
 /// ```yaml
 /// camera:   {width, height, center_px: [u, v], focal_mm, pixel_pitch_mm,
-///            azimuth_offset_deg, camera_height_m}
+///            azimuth_offset_deg, camera_height_m, and the rig's misalignments
+///            focal_scale, mirror_dz_mm, mirror_tilt_deg: [x, y], mirror_offset_mm: [x, y]}
 /// vision:   {sigma_px, half_window_px, auto_thresholds, high_threshold, low_threshold,
 ///            auto_not_edge_fraction, auto_low_ratio, auto_min_high_threshold,
 ///            min_fragment_px, horizontal_ratio, max_edges_per_column, blackman_smoothing,

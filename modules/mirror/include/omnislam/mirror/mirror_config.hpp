@@ -18,6 +18,33 @@ struct LobeConfig {
   double a_mm = 0.0;        ///< semi-major axis of the hyperbola
 };
 
+/// How an assembled rig differs from its design (issue 12). The defaults are the design:
+/// with every member at its default the model is the closed-form, rotationally symmetric one
+/// of mirror.md and results are bit-identical to a build without this struct.
+///
+/// The mirror is a rigid body (both lobes). Its pose in the camera frame (x = image u,
+/// y = image v, z up the optical axis, origin at the pinhole F0) is
+///     p_camera = R (p_design - pivot) + pivot + (offset_x, offset_y, dz),
+///     R = Ry(tilt_y) Rx(tilt_x),  pivot = (0, 0, inner focus height) = the designed F_I,
+/// so a tilt turns the mirror about two horizontal axes through the designed inner focus
+/// and the shifts then move it as a whole. The camera's true focal length is
+/// focal_scale * focal_mm (a lens focused slightly differently, or a sensor at another
+/// distance); the image centre is MirrorConfig::center_*_px as before.
+struct RigConfig {
+  double focal_scale = 1.0;         ///< true focal length / MirrorConfig::focal_mm
+  double mirror_dz_mm = 0.0;        ///< mirror moved up (+) along the camera axis
+  double mirror_tilt_x_rad = 0.0;   ///< mirror turned about the camera x axis (right-handed)
+  double mirror_tilt_y_rad = 0.0;   ///< then about the camera y axis (right-handed)
+  double mirror_offset_x_mm = 0.0;  ///< mirror moved along the camera x axis (image +u)
+  double mirror_offset_y_mm = 0.0;  ///< mirror moved along the camera y axis (image +v)
+
+  /// True when the rig is exactly as designed (the closed-form model applies).
+  [[nodiscard]] bool nominal() const {
+    return focal_scale == 1.0 && mirror_dz_mm == 0.0 && mirror_tilt_x_rad == 0.0 &&
+           mirror_tilt_y_rad == 0.0 && mirror_offset_x_mm == 0.0 && mirror_offset_y_mm == 0.0;
+  }
+};
+
 /// Camera intrinsics plus the mirror. All lengths in millimetres because the thesis's
 /// tables are; the model's public functions speak metres.
 struct MirrorConfig {
@@ -37,6 +64,11 @@ struct MirrorConfig {
   int rows_per_lobe = 225;
   int columns = 360;                ///< panorama columns, one per 360/columns degrees
   double azimuth_offset_deg = 0.0;  ///< shifts the azimuth origin (thesis Anguloajuste)
+
+  RigConfig rig;  ///< misalignments of the real rig (default: none)
+  /// Depth of the reference surface below the pinhole used by the panorama maps of a
+  /// misaligned rig (the floor: the camera height). Unused for a nominal rig.
+  double reference_depth_mm = 1000.0;
 };
 
 }  // namespace omnislam::mirror

@@ -4,6 +4,8 @@
 #include <vector>
 
 #include "omnislam/mirror/mirror_model.hpp"
+#include "omnislam/mirror/panorama_maps.hpp"
+#include "omnislam/mirror/rig_model.hpp"
 #include "omnislam/mirror/triangulation_table.hpp"
 #include "omnislam/stereo/stereo_config.hpp"
 
@@ -25,6 +27,15 @@ class RowTriangulator {
   /// both foci or a row is outside the panorama.
   [[nodiscard]] std::optional<mirror::MeridianPoint> triangulate(float inner_row, float outer_row) const;
 
+  /// The same for the rows of panorama column `column`. For a misaligned rig
+  /// (config.rig not nominal; issue 12) the rows are taken back to image positions through
+  /// the panorama maps (linear between integer rows), the two pixels back-projected by
+  /// the general model and the rays' closest point returned as (range from the camera
+  /// axis, height); both methods then use this path. For a nominal rig it is exactly
+  /// triangulate(inner_row, outer_row).
+  [[nodiscard]] std::optional<mirror::MeridianPoint> triangulate(int column, float inner_row,
+                                                                 float outer_row) const;
+
   /// Elevation (rad, from the nadir) of a fractional row, interpolated in the table.
   [[nodiscard]] double theta_of_row(mirror::Lobe lobe, float row) const;
 
@@ -35,6 +46,15 @@ class RowTriangulator {
   std::vector<double> theta_inner_;  ///< at rows -1, -1 + 1/32, ..., rows
   std::vector<double> theta_outer_;
   std::optional<mirror::TriangulationTable> table_;
+
+  /// Only for a misaligned rig: the general model and the panorama maps.
+  struct Rig {
+    mirror::RigModel model;
+    mirror::PanoramaMap inner;
+    mirror::PanoramaMap outer;
+  };
+  std::optional<Rig> rig_;
+  [[nodiscard]] std::optional<mirror::Ray3> rig_ray(mirror::Lobe lobe, int column, float row) const;
 };
 
 }  // namespace omnislam::stereo
