@@ -45,13 +45,15 @@ void building_row(int side) {
   std::uniform_real_distribution<double> yaw(-3.14, 3.14);
   for (int start = 0; start < 10; ++start) {
     const int room = pick_room(rng);
-    Eigen::Isometry2d pose = omnislam::test::pose((room % side) * 5.0 + 1.5, (room / side) * 5.0 + 2.5, yaw(rng));
+    Eigen::Isometry2d pose =
+        omnislam::test::pose((room % side) * 5.0 + 1.5, (room / side) * 5.0 + 2.5, yaw(rng));
     omnislam::slam::Relocalizer relocalizer(map);
     for (int frame = 1; frame <= 10; ++frame) {
       const auto scan = omnislam::test::scan_from(walls, pose, rng, 0.01, 6.0);
       const auto begin = std::chrono::steady_clock::now();
       const auto result = relocalizer.process(scan, pose);
-      frame_ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - begin).count());
+      frame_ms.push_back(
+          std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - begin).count());
       if (result.state == omnislam::slam::LocalizationState::kLocalized) {
         ++localized, frames_needed += frame;
         if ((result.T_map_base.translation() - pose.translation()).norm() <= 0.05) ++correct;
@@ -60,10 +62,11 @@ void building_row(int side) {
       pose = pose * omnislam::test::pose(0.1, 0.0, 0.05);
     }
   }
-  std::printf("| building %dx%d rooms (%.0f x %.0f m) | %zu | 10 | %d (%d / %d) | %.1f | %.1f / %.1f / %.1f |\n", side,
-              side, side * 5.0, side * 5.0, map.size(), localized, correct, localized - correct,
-              localized > 0 ? static_cast<double>(frames_needed) / localized : 0.0, quantile(frame_ms, 0.5),
-              quantile(frame_ms, 0.99), quantile(frame_ms, 1.0));
+  std::printf(
+      "| building %dx%d rooms (%.0f x %.0f m) | %zu | 10 | %d (%d / %d) | %.1f | %.1f / %.1f / %.1f |\n",
+      side, side, side * 5.0, side * 5.0, map.size(), localized, correct, localized - correct,
+      localized > 0 ? static_cast<double>(frames_needed) / localized : 0.0, quantile(frame_ms, 0.5),
+      quantile(frame_ms, 0.99), quantile(frame_ms, 1.0));
 }
 
 }  // namespace
@@ -74,16 +77,19 @@ int main(int argc, char **argv) {
     for (const char *name : {"sim-room-37", "sim-room-turning", "l-room-1lap", "office-real"})
       datasets.push_back(std::string(OMNISLAM_DEFAULT_DATASETS) + "/" + name);
   }
-  std::printf("| dataset | map points | starts | localized (correct / wrong) | frames to localize | ms per frame p50 / p99 / max |\n");
+  std::printf(
+      "| dataset | map points | starts | localized (correct / wrong) | frames to localize | ms per frame p50 "
+      "/ p99 / max |\n");
   std::printf("|---|---|---|---|---|---|\n");
   for (const std::string &dir : datasets) {
     const auto run = omnislam::test::build_localization_run(dir);
     const auto outcome = omnislam::test::relocalize_from_every_frame(run, 10);
     std::printf("| %s | %zu | %d | %d (%d / %d) | %.1f | %.1f / %.1f / %.1f |\n",
-                dir.substr(dir.find_last_of('/') + 1).c_str(), run.map.size(), outcome.starts, outcome.localized,
-                outcome.correct, outcome.wrong,
+                dir.substr(dir.find_last_of('/') + 1).c_str(), run.map.size(), outcome.starts,
+                outcome.localized, outcome.correct, outcome.wrong,
                 outcome.localized > 0 ? static_cast<double>(outcome.frames_needed) / outcome.localized : 0.0,
-                quantile(outcome.frame_ms, 0.5), quantile(outcome.frame_ms, 0.99), quantile(outcome.frame_ms, 1.0));
+                quantile(outcome.frame_ms, 0.5), quantile(outcome.frame_ms, 0.99),
+                quantile(outcome.frame_ms, 1.0));
   }
   if (argc == 1) {
     for (const int side : {4, 8}) building_row(side);

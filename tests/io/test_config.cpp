@@ -241,11 +241,13 @@ TEST_CASE("config: slam.loop_closure, with unknown keys and bad values naming ke
   CHECK(loops.graph.loop_chi2_limit == 16.27);
   CHECK(loops.ambiguity_ratio == defaults.slam.loop_closure.ambiguity_ratio);  // unset keys keep defaults
   CHECK_THROWS_WITH(
-      omnislam::io::load_config(write_file("loops-unknown.yaml", "slam:\n  loop_closure:\n    enable: true\n")),
+      omnislam::io::load_config(
+          write_file("loops-unknown.yaml", "slam:\n  loop_closure:\n    enable: true\n")),
       Catch::Contains("loops-unknown.yaml:3:") && Catch::Contains("unknown key 'slam.loop_closure.enable'"));
-  CHECK_THROWS_WITH(omnislam::io::load_config(
-                        write_file("loops-share.yaml", "slam:\n  loop_closure:\n    min_overlap: 1.5\n")),
-                    Catch::Contains("loops-share.yaml:3") && Catch::Contains("'slam.loop_closure.min_overlap'"));
+  CHECK_THROWS_WITH(
+      omnislam::io::load_config(
+          write_file("loops-share.yaml", "slam:\n  loop_closure:\n    min_overlap: 1.5\n")),
+      Catch::Contains("loops-share.yaml:3") && Catch::Contains("'slam.loop_closure.min_overlap'"));
   CHECK_THROWS_WITH(omnislam::io::load_config(
                         write_file("loops-count.yaml", "slam:\n  loop_closure:\n    max_candidates: 0\n")),
                     Catch::Contains("max_candidates"));

@@ -39,7 +39,8 @@ std::vector<Segment> pillared_hall(double period_m = 1.0) {
 
 // Laps around the hall (out along y = -0.6, back along y = +0.6), 0.2 m steps, turning.
 std::vector<Eigen::Isometry2d> hall_laps(int laps) {
-  const std::vector<Eigen::Vector2d> corners = {{-4.5, -0.6}, {4.5, -0.6}, {4.5, 0.6}, {-4.5, 0.6}, {-4.5, -0.6}};
+  const std::vector<Eigen::Vector2d> corners = {
+      {-4.5, -0.6}, {4.5, -0.6}, {4.5, 0.6}, {-4.5, 0.6}, {-4.5, -0.6}};
   std::vector<Eigen::Isometry2d> truth;
   for (int lap = 0; lap < laps; ++lap) {
     for (std::size_t c = 0; c + 1 < corners.size(); ++c) {
@@ -81,13 +82,14 @@ LoopRun run_slam(const SlamConfig &config, const std::vector<Segment> &walls,
     const FrameEstimate estimate = slam.process(omnislam::test::scan_from(walls, truth[i], rng), odometry[i]);
     run.truth.push_back(truth.front().inverse() * truth[i]);
     if (estimate.keyframe) run.keyframe_frame.push_back(static_cast<int>(i));
-    run.online_max_m =
-        std::max(run.online_max_m, (estimate.T_map_base.translation() - run.truth.back().translation()).norm());
+    run.online_max_m = std::max(run.online_max_m,
+                                (estimate.T_map_base.translation() - run.truth.back().translation()).norm());
   }
   const auto optimised = slam.trajectory();
   REQUIRE(optimised.size() == truth.size());
   for (std::size_t i = 0; i < truth.size(); ++i)
-    run.final_max_m = std::max(run.final_max_m, (optimised[i].translation() - run.truth[i].translation()).norm());
+    run.final_max_m =
+        std::max(run.final_max_m, (optimised[i].translation() - run.truth[i].translation()).norm());
   for (const PoseGraphEdge &edge : slam.keyframes().graph().edges())
     if (edge.loop) run.loops.push_back(edge);
   run.loop_closures = slam.loop_closures();
@@ -98,8 +100,10 @@ LoopRun run_slam(const SlamConfig &config, const std::vector<Segment> &walls,
 double worst_loop_error_m(const LoopRun &run) {
   double worst = 0.0;
   for (const PoseGraphEdge &edge : run.loops) {
-    const Eigen::Isometry2d &a = run.truth[static_cast<std::size_t>(run.keyframe_frame[static_cast<std::size_t>(edge.from)])];
-    const Eigen::Isometry2d &b = run.truth[static_cast<std::size_t>(run.keyframe_frame[static_cast<std::size_t>(edge.to)])];
+    const Eigen::Isometry2d &a =
+        run.truth[static_cast<std::size_t>(run.keyframe_frame[static_cast<std::size_t>(edge.from)])];
+    const Eigen::Isometry2d &b =
+        run.truth[static_cast<std::size_t>(run.keyframe_frame[static_cast<std::size_t>(edge.to)])];
     const Eigen::Isometry2d error = (a.inverse() * b).inverse() * edge.T_from_to;
     worst = std::max(worst, error.translation().norm());
   }
@@ -143,18 +147,22 @@ TEST_CASE("loop closure: a place one pillar bay away is never accepted as a matc
   const LoopMatch centred = match_keyframes(candidate, current, truth, 0.9, 10.0 * kDeg, config, {});
   CHECK(centred.status == LoopStatus::kAccepted);
   CHECK((truth.inverse() * centred.T_candidate_current).translation().norm() < 0.03);
-  const LoopMatch narrow = match_keyframes(candidate, current, pose(0.1, 0.0, 0.0) * truth, 0.3, 5.0 * kDeg, config, {});
+  const LoopMatch narrow =
+      match_keyframes(candidate, current, pose(0.1, 0.0, 0.0) * truth, 0.3, 5.0 * kDeg, config, {});
   CHECK(narrow.status == LoopStatus::kAccepted);
   CHECK((truth.inverse() * narrow.T_candidate_current).translation().norm() < 0.03);
 }
 
-TEST_CASE("loop closure: a corridor fit (one direction constrained) is refused as degenerate", "[slam][loop]") {
+TEST_CASE("loop closure: a corridor fit (one direction constrained) is refused as degenerate",
+          "[slam][loop]") {
   // Two long plain walls: along the corridor every shift fits.
   const std::vector<Segment> corridor = {{{-20, -1.0}, {20, -1.0}}, {{-20, 1.0}, {20, 1.0}}};
   const Eigen::Isometry2d here = pose(0.0, 0.0, 0.0);
   const Points2 candidate = scan_at(corridor, here, 3), current = scan_at(corridor, here, 4);
-  const LoopMatch match = match_keyframes(candidate, current, Eigen::Isometry2d::Identity(), 0.3, 5.0 * kDeg, {}, {});
-  INFO("status " << static_cast<int>(match.status) << ", score " << match.score << ", second " << match.second_score);
+  const LoopMatch match =
+      match_keyframes(candidate, current, Eigen::Isometry2d::Identity(), 0.3, 5.0 * kDeg, {}, {});
+  INFO("status " << static_cast<int>(match.status) << ", score " << match.score << ", second "
+                 << match.second_score);
   CHECK((match.status == LoopStatus::kAmbiguous || match.status == LoopStatus::kDegenerate));
 }
 
@@ -171,7 +179,8 @@ TEST_CASE("loop closure: no false loop closure in a hall of identical bays", "[s
 }
 
 TEST_CASE("loop closure: two laps of the L-room close the loop and stay accurate", "[slam][loop]") {
-  const std::vector<Eigen::Vector2d> corners = {{0, 0}, {5, 0}, {5, 0.6}, {1.5, 0.6}, {1.5, 3}, {0, 3}, {0, 0}};
+  const std::vector<Eigen::Vector2d> corners = {{0, 0},   {5, 0}, {5, 0.6}, {1.5, 0.6},
+                                                {1.5, 3}, {0, 3}, {0, 0}};
   std::vector<Eigen::Isometry2d> truth;
   for (int lap = 0; lap < 2; ++lap) {
     for (std::size_t c = 0; c + 1 < corners.size(); ++c) {
@@ -191,8 +200,8 @@ TEST_CASE("loop closure: two laps of the L-room close the loop and stay accurate
     const LoopRun closed = run_slam(SlamConfig{}, omnislam::test::l_room(), truth, seed);
     const LoopRun open = run_slam(without, omnislam::test::l_room(), truth, seed);
     INFO("seed " << seed << ": " << closed.loop_closures << " closures, " << closed.loops.size()
-                 << " loop edges (worst " << worst_loop_error_m(closed) << " m); optimised max " << closed.final_max_m
-                 << " m, without loop closure " << open.final_max_m << " m");
+                 << " loop edges (worst " << worst_loop_error_m(closed) << " m); optimised max "
+                 << closed.final_max_m << " m, without loop closure " << open.final_max_m << " m");
     CHECK(closed.loop_closures > 0);
     CHECK(worst_loop_error_m(closed) < 0.05);
     CHECK(closed.final_max_m < 0.05);

@@ -63,7 +63,8 @@ struct DriftedSquare {
   [[nodiscard]] double max_error_m() const {
     double worst = 0.0;
     for (int i = 0; i < graph.size(); ++i)
-      worst = std::max(worst, (graph.pose(i).translation() - truth[static_cast<std::size_t>(i)].translation()).norm());
+      worst = std::max(
+          worst, (graph.pose(i).translation() - truth[static_cast<std::size_t>(i)].translation()).norm());
     return worst;
   }
   [[nodiscard]] int last() const { return graph.size() - 1; }
@@ -76,7 +77,8 @@ TEST_CASE("pose graph: a square loop with drifted odometry is closed by one loop
   const double drifted_max_m = square.max_error_m();
   const double drifted_end_m = (square.graph.pose(square.last()).translation()).norm();
   // The loop edge: the last node is at the first one (a registration with 5 mm, 0.2 deg).
-  square.graph.add_edge({0, square.last(), Eigen::Isometry2d::Identity(), information(0.005, 0.2 * kDeg), true});
+  square.graph.add_edge(
+      {0, square.last(), Eigen::Isometry2d::Identity(), information(0.005, 0.2 * kDeg), true});
   const PoseGraphResult result = square.graph.optimize();
   CHECK(result.converged);
   CHECK(result.rejected_loops == 0);
@@ -90,8 +92,8 @@ TEST_CASE("pose graph: a square loop with drifted odometry is closed by one loop
 
 TEST_CASE("pose graph: an injected false loop edge is rejected and moves the result by less than 10 mm") {
   DriftedSquare reference(11), attacked(11);
-  const PoseGraphEdge true_loop{0, reference.last(), Eigen::Isometry2d::Identity(), information(0.005, 0.2 * kDeg),
-                                true};
+  const PoseGraphEdge true_loop{0, reference.last(), Eigen::Isometry2d::Identity(),
+                                information(0.005, 0.2 * kDeg), true};
   reference.graph.add_edge(true_loop);
   attacked.graph.add_edge(true_loop);
   // A confident loop edge between the first corner and the opposite one, as a matcher
@@ -107,7 +109,8 @@ TEST_CASE("pose graph: an injected false loop edge is rejected and moves the res
   CHECK(loops == 1);  // the true loop edge stays
   double moved_m = 0.0;
   for (int i = 0; i < reference.graph.size(); ++i)
-    moved_m = std::max(moved_m, (attacked.graph.pose(i).translation() - reference.graph.pose(i).translation()).norm());
+    moved_m = std::max(moved_m,
+                       (attacked.graph.pose(i).translation() - reference.graph.pose(i).translation()).norm());
   CHECK(moved_m < 0.010);
 }
 
@@ -133,10 +136,11 @@ TEST_CASE("pose graph: fewer than two nodes is a no-op") {
   CHECK((graph.pose(0).translation() - Eigen::Vector2d(1.0, 2.0)).norm() < 1e-12);
 }
 
-TEST_CASE("pose graph: three injected false loop edges are all rejected and move the result by less than 10 mm") {
+TEST_CASE(
+    "pose graph: three injected false loop edges are all rejected and move the result by less than 10 mm") {
   DriftedSquare reference(5), attacked(5);
-  const PoseGraphEdge true_loop{0, reference.last(), Eigen::Isometry2d::Identity(), information(0.005, 0.2 * kDeg),
-                                true};
+  const PoseGraphEdge true_loop{0, reference.last(), Eigen::Isometry2d::Identity(),
+                                information(0.005, 0.2 * kDeg), true};
   reference.graph.add_edge(true_loop);
   attacked.graph.add_edge(true_loop);
   // Confident, mutually inconsistent claims: opposite corners seen as neighbours, a side
@@ -149,7 +153,8 @@ TEST_CASE("pose graph: three injected false loop edges are all rejected and move
   CHECK(result.rejected_loops == 3);
   double moved_m = 0.0;
   for (int i = 0; i < reference.graph.size(); ++i)
-    moved_m = std::max(moved_m, (attacked.graph.pose(i).translation() - reference.graph.pose(i).translation()).norm());
+    moved_m = std::max(moved_m,
+                       (attacked.graph.pose(i).translation() - reference.graph.pose(i).translation()).norm());
   CHECK(moved_m < 0.010);
   CHECK(std::abs(attacked.max_error_m() - reference.max_error_m()) < 0.010);
 }

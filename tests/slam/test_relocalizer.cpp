@@ -25,7 +25,9 @@ Points2 wall_points(const std::vector<Segment> &walls) {
 }
 
 std::vector<Segment> rectangle(double width_m, double depth_m) {
-  return {{{0, 0}, {width_m, 0}}, {{width_m, 0}, {width_m, depth_m}}, {{width_m, depth_m}, {0, depth_m}},
+  return {{{0, 0}, {width_m, 0}},
+          {{width_m, 0}, {width_m, depth_m}},
+          {{width_m, depth_m}, {0, depth_m}},
           {{0, depth_m}, {0, 0}}};
 }
 
@@ -51,7 +53,8 @@ TEST_CASE("correlative search finds the pose of a scan over the whole map", "[sl
   const auto candidates = matcher.search(scan, 0.5, 0.8, 0.5, 0.35);
   REQUIRE_FALSE(candidates.empty());
   CHECK(error_m(candidates.front().T_map_base, truth) <= 0.05);
-  CHECK(std::abs(std::remainder(omnislam::slam::yaw_rad_of(candidates.front().T_map_base) - 2.3, 2 * std::numbers::pi)) <= 0.02);
+  CHECK(std::abs(std::remainder(omnislam::slam::yaw_rad_of(candidates.front().T_map_base) - 2.3,
+                                2 * std::numbers::pi)) <= 0.02);
   CHECK(matcher.score(scan, truth) >= 0.8);
   CHECK(matcher.score(scan, planar_pose(1.0, 3.0, 0.0)) < 0.5);
 }
@@ -158,7 +161,8 @@ TEST_CASE("relocalisation in a building whose rooms differ finds the room", "[sl
   std::optional<Eigen::Isometry2d> found;
   std::size_t frame = 0;
   for (; frame < path.size() && !found; ++frame) {
-    const auto result = relocalizer.process(omnislam::test::scan_from(walls, path[frame], rng, 0.01, 6.0), path[frame]);
+    const auto result =
+        relocalizer.process(omnislam::test::scan_from(walls, path[frame], rng, 0.01, 6.0), path[frame]);
     if (result.state == LocalizationState::kLocalized) found = result.T_map_base;
   }
   REQUIRE(found);

@@ -27,8 +27,8 @@ TEST_CASE("relocalisation from every frame of the bundled rooms", "[slam][reloca
     const auto run = omnislam::test::build_localization_run(dataset_dir(name));
     const auto outcome = omnislam::test::relocalize_from_every_frame(run, 10);
     std::printf("%s: %d starts, %d localized (%d correct, %d wrong), worst %.1f mm %.2f deg\n", name,
-                outcome.starts, outcome.localized, outcome.correct, outcome.wrong, outcome.worst_error_m * 1000.0,
-                outcome.worst_error_deg);
+                outcome.starts, outcome.localized, outcome.correct, outcome.wrong,
+                outcome.worst_error_m * 1000.0, outcome.worst_error_deg);
     starts += outcome.starts, correct += outcome.correct, wrong += outcome.wrong;
   }
   CHECK(starts >= 100);

@@ -63,7 +63,8 @@ RelocalizationOutcome relocalize_from_every_frame(const LocalizationRun &run, in
         outcome.worst_error_deg = std::max(outcome.worst_error_deg, error_deg);
       } else {
         ++outcome.wrong;
-        std::printf("  wrong pose: start %d, frame %d: %.3f m, %.2f deg off\n", start + 1, f + 1, error_m, error_deg);
+        std::printf("  wrong pose: start %d, frame %d: %.3f m, %.2f deg off\n", start + 1, f + 1, error_m,
+                    error_deg);
       }
       break;
     }

@@ -14,10 +14,10 @@
 namespace omnislam::test {
 
 struct LocalizationRun {
-  std::vector<slam::Points2> scans;          ///< base_link, per frame
-  std::vector<Eigen::Isometry2d> odometry;   ///< the dataset's noisy odometry
-  std::vector<Eigen::Isometry2d> truth;      ///< map frame = the first frame's pose
-  slam::Points2 map;                         ///< the map after the whole run
+  std::vector<slam::Points2> scans;         ///< base_link, per frame
+  std::vector<Eigen::Isometry2d> odometry;  ///< the dataset's noisy odometry
+  std::vector<Eigen::Isometry2d> truth;     ///< map frame = the first frame's pose
+  slam::Points2 map;                        ///< the map after the whole run
 };
 
 /// Front-end and SLAM over every frame of the dataset in `dir` (throws naming a missing file).
@@ -26,10 +26,10 @@ struct LocalizationRun {
 struct RelocalizationOutcome {
   int starts = 0;
   int localized = 0;
-  int correct = 0;  ///< localized within 50 mm and 1 deg of the truth
-  int wrong = 0;    ///< localized anywhere else
-  int frames_needed = 0;  ///< summed over the localized starts (the confirming frame included)
-  double worst_error_m = 0.0;    ///< of the correct ones
+  int correct = 0;             ///< localized within 50 mm and 1 deg of the truth
+  int wrong = 0;               ///< localized anywhere else
+  int frames_needed = 0;       ///< summed over the localized starts (the confirming frame included)
+  double worst_error_m = 0.0;  ///< of the correct ones
   double worst_error_deg = 0.0;
   std::vector<double> frame_ms;  ///< time of every relocaliser frame before localization
 };

@@ -66,8 +66,9 @@ void evaluate(const std::filesystem::path &run_dir, const std::filesystem::path 
   if (has_online) {
     online = io::to_isometries(io::read_tum_file(run_dir / "trajectory_online.tum"));
     if (online.size() != estimate.size()) {
-      throw std::runtime_error((run_dir / "trajectory_online.tum").string() + ": " + std::to_string(online.size()) +
-                               " poses for " + std::to_string(estimate.size()) + " in trajectory.tum");
+      throw std::runtime_error((run_dir / "trajectory_online.tum").string() + ": " +
+                               std::to_string(online.size()) + " poses for " +
+                               std::to_string(estimate.size()) + " in trajectory.tum");
     }
   }
   const auto slam_error = slam::trajectory_error(estimate, truth);

@@ -12,8 +12,8 @@
 #include <exception>
 #include <filesystem>
 #include <limits>
-#include <numbers>
 #include <memory>
+#include <numbers>
 #include <optional>
 #include <utility>
 
@@ -111,9 +111,9 @@ int run_service(const std::string &config_file) {
   const std::optional<io::Snapshot> resumed = resume_state(config, snapshot_file, config_hash);
   // Resumed with the pose unknown (a robot carried while off): found on the saved map first.
   const io::PersistenceConfig::StartPose start_pose = config.persistence.start_pose;
-  const bool search_start = resumed && (start_pose == io::PersistenceConfig::StartPose::kSearch ||
-                                        (start_pose == io::PersistenceConfig::StartPose::kAuto &&
-                                         config.slam.localization_only));
+  const bool search_start =
+      resumed && (start_pose == io::PersistenceConfig::StartPose::kSearch ||
+                  (start_pose == io::PersistenceConfig::StartPose::kAuto && config.slam.localization_only));
 
   sigset_t signals;
   sigemptyset(&signals);
@@ -206,10 +206,11 @@ int run_service(const std::string &config_file) {
     }
     if (!posed) {
       posed = true;
-      spdlog::info("localized on the saved map at frame {} after {} frames: x {:.3f} m, y {:.3f} m, yaw {:.1f} deg",
-                   frame.sequence, not_localized, frame.estimate.T_map_base.translation().x(),
-                   frame.estimate.T_map_base.translation().y(),
-                   slam::yaw_rad_of(frame.estimate.T_map_base) * 180.0 / std::numbers::pi);
+      spdlog::info(
+          "localized on the saved map at frame {} after {} frames: x {:.3f} m, y {:.3f} m, yaw {:.1f} deg",
+          frame.sequence, not_localized, frame.estimate.T_map_base.translation().x(),
+          frame.estimate.T_map_base.translation().y(),
+          slam::yaw_rad_of(frame.estimate.T_map_base) * 180.0 / std::numbers::pi);
       if (publisher)
         publisher->status({system_time_s(), dds::ServiceState::kRunning, frame.sequence, 0, 0, ""});
     }
@@ -246,9 +247,10 @@ int run_service(const std::string &config_file) {
                               pipeline_config(config, input.rate_hz, snapshots.has_value()),
                               std::move(sinks));
   if (search_start) {
-    spdlog::info("searching for the pose on the saved map ({} points; persistence.start_pose {}): nothing is "
-                 "published until one pose is confirmed",
-                 resumed->points.size(), config.slam.localization_only ? "auto, localization_only" : "search");
+    spdlog::info(
+        "searching for the pose on the saved map ({} points; persistence.start_pose {}): nothing is "
+        "published until one pose is confirmed",
+        resumed->points.size(), config.slam.localization_only ? "auto, localization_only" : "search");
     pipeline.relocalize(resumed->points, resumed->map_integrations);
     status.state = dds::ServiceState::kLocalizing;  // running becomes the publish thread's to say
     status.stamp_s = system_time_s();
@@ -314,7 +316,8 @@ int run_service(const std::string &config_file) {
     info.name = "omnislamd";
     for (const FrameRecord &f : run.frames)
       run.odometry_map.push_back(run.frames.front().T_odom_base.inverse() * f.T_odom_base);
-    OutputWriter(service.output_dir).write_all(run, pipeline.slam().map(), info, pipeline.slam().trajectory());
+    OutputWriter(service.output_dir)
+        .write_all(run, pipeline.slam().map(), info, pipeline.slam().trajectory());
     if (final_grid.width > 0)
       io::write_nav2_map(std::filesystem::path(service.output_dir) / "map.yaml", final_grid);
   }
@@ -329,7 +332,8 @@ int run_service(const std::string &config_file) {
   spdlog::info("stopped: {} frames in, {} out, {} dropped, {} skipped, {} without odometry", status.frames_in,
                status.frames_out, status.frames_dropped, counts.skipped.load(),
                counts.without_odometry.load());
-  if (search_start && posed) spdlog::info("{} frames before the pose was found on the saved map", not_localized);
+  if (search_start && posed)
+    spdlog::info("{} frames before the pose was found on the saved map", not_localized);
   if (search_start && !posed)
     spdlog::warn("{} frames and no pose found on the saved map (it is kept unchanged)", not_localized);
   if (!pipeline.error().empty()) {

@@ -110,13 +110,14 @@ void run_replay(const ReplayOptions &options, std::optional<std::uint64_t> degra
   if (!pipeline.error().empty()) throw std::runtime_error(pipeline.error());
   writer.write_all(run, pipeline.slam().map(), info, pipeline.slam().trajectory());
   if (run.localizing) {
-    const auto first = std::find_if(run.frames.begin(), run.frames.end(), [](const FrameRecord &f) { return f.localized; });
+    const auto first =
+        std::find_if(run.frames.begin(), run.frames.end(), [](const FrameRecord &f) { return f.localized; });
     if (first == run.frames.end()) {
       std::printf("not localized on %s: no pose confirmed in %zu frames (trajectory.tum has none)\n",
                   options.map_file.c_str(), run.frames.size());
     } else {
-      std::printf("localized on %s at frame %td (%td frames before it have no pose)\n", options.map_file.c_str(),
-                  first - run.frames.begin() + 1, first - run.frames.begin());
+      std::printf("localized on %s at frame %td (%td frames before it have no pose)\n",
+                  options.map_file.c_str(), first - run.frames.begin() + 1, first - run.frames.begin());
     }
   }
   const grid::GridImage grid_image = occupancy.image();
@@ -150,9 +151,10 @@ void add_replay_command(CLI::App &app) {
                                            "seed of the image degradation (default: the config's, 1)");
   auto *map = command->add_option("--map", options->map_file, "a saved map (snapshot) to localize on");
   command
-      ->add_flag("--localize", options->localize,
-                 "start on --map from an unknown pose: search the map, confirm over several frames, then track "
-                 "without changing the map; frames before the pose is confirmed are left out of trajectory.tum")
+      ->add_flag(
+          "--localize", options->localize,
+          "start on --map from an unknown pose: search the map, confirm over several frames, then track "
+          "without changing the map; frames before the pose is confirmed are left out of trajectory.tum")
       ->needs(map);
   map->needs(command->get_option("--localize"));
   command->callback([options, degrade_seed] {

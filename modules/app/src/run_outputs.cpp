@@ -202,7 +202,8 @@ void OutputWriter::write_all(const RunRecord &all, const slam::PointMap &map, co
   summary["not_integrated"] = static_cast<long>(all.frames.size()) - integrated;
   summary["skipped"] = std::count_if(all.frames.begin(), all.frames.end(), [](auto &f) { return f.skipped; });
   if (all.localizing) summary["not_localized"] = all.frames.size() - run.frames.size();
-  summary["keyframes"] = std::count_if(run.frames.begin(), run.frames.end(), [](auto &f) { return f.keyframe; });
+  summary["keyframes"] =
+      std::count_if(run.frames.begin(), run.frames.end(), [](auto &f) { return f.keyframe; });
   summary["loop_closures"] =
       std::count_if(run.frames.begin(), run.frames.end(), [](auto &f) { return f.loop_closed; });
   summary["map_points"] = map.points().size();

@@ -24,7 +24,7 @@ struct FrameRecord {
   Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
   bool skipped = false;  ///< the image could not be used
   bool integrated = false;
-  bool localized = true;  ///< false: still searching for its pose on a saved map (no pose)
+  bool localized = true;     ///< false: still searching for its pose on a saved map (no pose)
   bool keyframe = false;     ///< became a keyframe of the pose graph
   bool loop_closed = false;  ///< a loop closure corrected the graph at this frame
   slam::Attempt attempt = slam::Attempt::kNone;

@@ -158,8 +158,8 @@ void Publisher::profile(double stamp_s, const pipeline::ProfileSnapshot &profile
 }
 
 void Publisher::status(const StatusMessage &status) {
-  static constexpr std::array<const char *, 6> kNames = {"starting", "running", "stopping", "stopped",
-                                                         "failed",   "localizing"};
+  static constexpr std::array<const char *, 6> kNames = {"starting", "running", "stopping",
+                                                         "stopped",  "failed",  "localizing"};
   std::string state_name = kNames[static_cast<std::size_t>(status.state)];
   std::string error = status.last_error;
   omnislam_msg_dds__Status_ msg{};

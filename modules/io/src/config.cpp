@@ -233,7 +233,8 @@ void read_loop_closure(YamlSection &section, slam::LoopClosureConfig &loops) {
                                    {"min_weak_direction_share", loops.min_weak_direction_share}}) {
     if (!(value >= 0.0 && value <= 1.0)) section.fail(key, "must be in [0, 1]");
   }
-  if (loops.max_candidates < 1 || loops.max_candidates > 50) section.fail("max_candidates", "must be in 1..50");
+  if (loops.max_candidates < 1 || loops.max_candidates > 50)
+    section.fail("max_candidates", "must be in 1..50");
   if (loops.max_sample_points < 10 || loops.max_sample_points > 10000)
     section.fail("max_sample_points", "must be in 10..10000");
 }

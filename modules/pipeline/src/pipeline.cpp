@@ -242,7 +242,8 @@ void Pipeline::stereo_loop() {
   queues_[kSlamQueue].close();
 }
 
-void Pipeline::narrow_search(const Frame::PoseReset &rough, const std::optional<Eigen::Isometry2d> &T_odom_base) {
+void Pipeline::narrow_search(const Frame::PoseReset &rough,
+                             const std::optional<Eigen::Isometry2d> &T_odom_base) {
   // Three standard deviations of the rough pose, never less than what the relocaliser takes
   // for one and the same pose.
   const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> position(rough.covariance.topLeftCorner<2, 2>());
@@ -265,7 +266,8 @@ void Pipeline::relocalize_frame(Frame &frame, const std::optional<Eigen::Isometr
   if (!frame.localized) return;
   frame.estimate.T_map_base = found.T_map_base;
   frame.estimate.covariance = found.covariance;
-  slam_.resume(std::move(saved_points_), saved_integrations_, found.T_map_base, found.covariance, T_odom_base);
+  slam_.resume(std::move(saved_points_), saved_integrations_, found.T_map_base, found.covariance,
+               T_odom_base);
   relocalizer_.reset();
 }
 

@@ -52,8 +52,9 @@ CorrelativeMatcher::CorrelativeMatcher(const Points2 &map_points, CorrelativeMat
         if (x < 0 || y < 0 || x >= width_ || y >= height_) continue;
         const Eigen::Vector2d centre = origin_m_ + resolution * Eigen::Vector2d(x + 0.5, y + 0.5);
         const auto value = static_cast<float>(std::exp(-(centre - p).squaredNorm() * inverse_two_sigma_sq));
-        float &stored = likelihood[static_cast<std::size_t>(y + padding_) * static_cast<std::size_t>(stride_) +
-                                   static_cast<std::size_t>(x + padding_)];
+        float &stored =
+            likelihood[static_cast<std::size_t>(y + padding_) * static_cast<std::size_t>(stride_) +
+                       static_cast<std::size_t>(x + padding_)];
         stored = std::max(stored, value);
       }
     }
@@ -73,8 +74,10 @@ CorrelativeMatcher::CorrelativeMatcher(const Points2 &map_points, CorrelativeMat
                              static_cast<std::size_t>(xx)]
                      : 0.0f;
         };
-        coarser[static_cast<std::size_t>(y) * static_cast<std::size_t>(stride_) + static_cast<std::size_t>(x)] =
-            std::max(std::max(value(x, y), value(x + half, y)), std::max(value(x, y + half), value(x + half, y + half)));
+        coarser[static_cast<std::size_t>(y) * static_cast<std::size_t>(stride_) +
+                static_cast<std::size_t>(x)] =
+            std::max(std::max(value(x, y), value(x + half, y)),
+                     std::max(value(x, y + half), value(x + half, y + half)));
       }
     }
     levels_.push_back(std::move(coarser));
@@ -85,7 +88,8 @@ float CorrelativeMatcher::at(int level, int x, int y) const {
   const int px = x + padding_, py = y + padding_;
   if (px < 0 || py < 0 || px >= stride_ || py >= height_ + padding_) return 0.0f;
   return levels_[static_cast<std::size_t>(level)]
-                [static_cast<std::size_t>(py) * static_cast<std::size_t>(stride_) + static_cast<std::size_t>(px)];
+                [static_cast<std::size_t>(py) * static_cast<std::size_t>(stride_) +
+                 static_cast<std::size_t>(px)];
 }
 
 Points2 CorrelativeMatcher::thinned(const Points2 &scan_base) const {
@@ -135,7 +139,8 @@ std::vector<PoseCandidate> CorrelativeMatcher::search(const Points2 &scan_base, 
   // Yaw step: the farthest point moves by at most one cell between neighbouring yaws.
   double farthest_m = resolution;
   for (const Point2 &p : scan) farthest_m = std::max(farthest_m, p.norm());
-  const double step_rad = std::acos(std::max(-1.0, 1.0 - resolution * resolution / (2.0 * farthest_m * farthest_m)));
+  const double step_rad =
+      std::acos(std::max(-1.0, 1.0 - resolution * resolution / (2.0 * farthest_m * farthest_m)));
   std::vector<double> yaws;
   if (window) {
     const int half = static_cast<int>(std::ceil(window->half_angle_rad / step_rad));
@@ -216,18 +221,21 @@ std::vector<PoseCandidate> CorrelativeMatcher::search(const Points2 &scan_base, 
         if (child.bound >= threshold) children.push_back(child);
       }
     }
-    std::sort(children.begin(), children.end(), [](const Node &a, const Node &b) { return a.bound < b.bound; });
+    std::sort(children.begin(), children.end(),
+              [](const Node &a, const Node &b) { return a.bound < b.bound; });
     stack.insert(stack.end(), children.begin(), children.end());
   }
 
   // Distinct poses, best first: a leaf near a better one is the same peak.
-  std::sort(leaves.begin(), leaves.end(), [](const PoseCandidate &a, const PoseCandidate &b) { return a.score > b.score; });
+  std::sort(leaves.begin(), leaves.end(),
+            [](const PoseCandidate &a, const PoseCandidate &b) { return a.score > b.score; });
   std::vector<PoseCandidate> distinct;
   for (const PoseCandidate &leaf : leaves) {
     if (leaf.score < relative_score * best) break;
     const bool known = std::any_of(distinct.begin(), distinct.end(), [&](const PoseCandidate &kept) {
       return (kept.T_map_base.translation() - leaf.T_map_base.translation()).norm() <= distinct_m &&
-             std::abs(std::remainder(yaw_rad_of(kept.T_map_base) - yaw_rad_of(leaf.T_map_base), 2.0 * std::numbers::pi)) <= distinct_rad;
+             std::abs(std::remainder(yaw_rad_of(kept.T_map_base) - yaw_rad_of(leaf.T_map_base),
+                                     2.0 * std::numbers::pi)) <= distinct_rad;
     });
     if (!known) distinct.push_back(leaf);
   }

@@ -57,7 +57,9 @@ bool KeyframeGraph::add_integrated(const Points2 &scan_base, const Eigen::Isomet
       const double sigma_yaw = config_.edge_floor_yaw_rad + config_.drift_yaw_per_m * travelled_m;
       const Eigen::Matrix3d covariance =
           in_frame(registration_covariance, previous.T_map_keyframe.linear()) +
-          Eigen::Vector3d(sigma_xy * sigma_xy, sigma_xy * sigma_xy, sigma_yaw * sigma_yaw).asDiagonal().toDenseMatrix();
+          Eigen::Vector3d(sigma_xy * sigma_xy, sigma_xy * sigma_xy, sigma_yaw * sigma_yaw)
+              .asDiagonal()
+              .toDenseMatrix();
       graph_.add_edge({node - 1, node, T_previous_current, covariance.inverse(), false});
     }
     keyframes_.push_back({T_map_base, path_m_, {}});
@@ -84,8 +86,8 @@ KeyframeGraph::Correction KeyframeGraph::optimize(const PoseGraphConfig &config)
   for (int k = 0; k <= last(); ++k) {
     Keyframe &keyframe = keyframes_[static_cast<std::size_t>(k)];
     const Eigen::Isometry2d optimised = graph_.pose(k);
-    correction.max_shift_m =
-        std::max(correction.max_shift_m, (optimised.translation() - keyframe.T_map_keyframe.translation()).norm());
+    correction.max_shift_m = std::max(
+        correction.max_shift_m, (optimised.translation() - keyframe.T_map_keyframe.translation()).norm());
     keyframe.T_map_keyframe = optimised;
   }
   return correction;
@@ -109,7 +111,8 @@ PointMap KeyframeGraph::rebuilt_map(const PointMapConfig &config, const std::vec
   PointMap map = base.empty() ? PointMap(config) : PointMap(config, base, base_integrations);
   for (const auto &[k, scan] : integration_order_) {
     const Keyframe &keyframe = keyframes_[static_cast<std::size_t>(k)];
-    map.integrate(transformed(keyframe.scans_keyframe[static_cast<std::size_t>(scan)], keyframe.T_map_keyframe));
+    map.integrate(
+        transformed(keyframe.scans_keyframe[static_cast<std::size_t>(scan)], keyframe.T_map_keyframe));
   }
   return map;
 }
@@ -118,9 +121,9 @@ std::vector<Eigen::Isometry2d> KeyframeGraph::trajectory() const {
   std::vector<Eigen::Isometry2d> poses;
   poses.reserve(frames_.size());
   for (const FrameAnchor &frame : frames_) {
-    poses.push_back(frame.keyframe < 0
-                        ? frame.T_keyframe_base
-                        : keyframes_[static_cast<std::size_t>(frame.keyframe)].T_map_keyframe * frame.T_keyframe_base);
+    poses.push_back(frame.keyframe < 0 ? frame.T_keyframe_base
+                                       : keyframes_[static_cast<std::size_t>(frame.keyframe)].T_map_keyframe *
+                                             frame.T_keyframe_base);
   }
   return poses;
 }

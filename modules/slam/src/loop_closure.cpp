@@ -51,7 +51,8 @@ class ScoreGrid {
       for (int x = 0; x < width_; ++x) {
         float value = 0.0f;
         for (int dy = 0; dy < block && y + dy < height_; ++dy)
-          for (int dx = 0; dx < block && x + dx < width_; ++dx) value = std::max(value, values_[index(x + dx, y + dy)]);
+          for (int dx = 0; dx < block && x + dx < width_; ++dx)
+            value = std::max(value, values_[index(x + dx, y + dy)]);
         out.values_[index(x, y)] = value;
       }
     }
@@ -120,7 +121,8 @@ double weak_direction_share(const TrimmedIcpResult &r) {
   const Eigen::Matrix2d covariance_xy = r.covariance.topLeftCorner<2, 2>();
   if (!(std::abs(covariance_xy.determinant()) > 0.0)) return 0.0;
   const Eigen::Matrix2d information_xy = sigma2 * covariance_xy.inverse();
-  const double weakest = Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(information_xy).eigenvalues().minCoeff();
+  const double weakest =
+      Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(information_xy).eigenvalues().minCoeff();
   return weakest / static_cast<double>(r.kept_pairs);
 }
 
@@ -211,8 +213,8 @@ LoopMatch match_keyframes(const Points2 &candidate_scans, const Points2 &current
     }
   }
   const Eigen::Isometry2d coarse =
-      planar_pose(guess.translation().x() + best_ix * resolution, guess.translation().y() + best_iy * resolution,
-                  guess_yaw + best_a * yaw_step);
+      planar_pose(guess.translation().x() + best_ix * resolution,
+                  guess.translation().y() + best_iy * resolution, guess_yaw + best_a * yaw_step);
   match.T_candidate_current = coarse;
   if (match.score < config.min_score) {
     match.status = LoopStatus::kLowScore;
@@ -245,8 +247,8 @@ LoopMatch match_keyframes(const Points2 &candidate_scans, const Points2 &current
   return match;
 }
 
-LoopMatch search_loop(const KeyframeGraph &graph, const LoopClosureConfig &config, const TrimmedIcpConfig &icp,
-                      const std::optional<LoopMatch> &last_loop) {
+LoopMatch search_loop(const KeyframeGraph &graph, const LoopClosureConfig &config,
+                      const TrimmedIcpConfig &icp, const std::optional<LoopMatch> &last_loop) {
   LoopMatch none;
   const int current = graph.last();
   if (current < 1) return none;
@@ -273,8 +275,8 @@ LoopMatch search_loop(const KeyframeGraph &graph, const LoopClosureConfig &confi
     }
     const double window_m =
         std::min(3.0 * (drift.edge_floor_xy_m + drift.drift_per_m * drift_path_m), config.max_window_m);
-    const double window_rad =
-        std::min(3.0 * (drift.edge_floor_yaw_rad + drift.drift_yaw_per_m * drift_path_m), config.max_window_rad);
+    const double window_rad = std::min(
+        3.0 * (drift.edge_floor_yaw_rad + drift.drift_yaw_per_m * drift_path_m), config.max_window_rad);
     const double distance_m = (now.T_map_keyframe.translation() - old.T_map_keyframe.translation()).norm();
     if (distance_m <= config.max_candidate_distance_m + window_m)
       candidates.push_back({k, distance_m, window_m, window_rad});
@@ -291,19 +293,20 @@ LoopMatch search_loop(const KeyframeGraph &graph, const LoopClosureConfig &confi
     const Keyframe &old = keyframes[static_cast<std::size_t>(c.keyframe)];
     const Points2 candidate_points =
         graph.submap(c.keyframe, config.submap_path_m, now.path_m - config.min_path_gap_m);
-    LoopMatch match = match_keyframes(candidate_points, current_points,
-                                      old.T_map_keyframe.inverse() * now.T_map_keyframe, c.window_m, c.window_rad,
-                                      config, icp);
+    LoopMatch match =
+        match_keyframes(candidate_points, current_points, old.T_map_keyframe.inverse() * now.T_map_keyframe,
+                        c.window_m, c.window_rad, config, icp);
     match.candidate = c.keyframe;
     match.current = current;
     matches.push_back(match);
   }
   // The best-scoring hypothesis; another candidate that places the current keyframe
   // elsewhere with a comparable score makes it ambiguous.
-  const auto best = std::max_element(matches.begin(), matches.end(), [](const LoopMatch &a, const LoopMatch &b) {
-    const bool a_ok = a.status == LoopStatus::kAccepted, b_ok = b.status == LoopStatus::kAccepted;
-    return a_ok != b_ok ? b_ok : a.score < b.score;
-  });
+  const auto best =
+      std::max_element(matches.begin(), matches.end(), [](const LoopMatch &a, const LoopMatch &b) {
+        const bool a_ok = a.status == LoopStatus::kAccepted, b_ok = b.status == LoopStatus::kAccepted;
+        return a_ok != b_ok ? b_ok : a.score < b.score;
+      });
   LoopMatch chosen = *best;
   if (chosen.status != LoopStatus::kAccepted) return chosen;
   const auto placed = [&](const LoopMatch &m) {
@@ -327,7 +330,8 @@ bool agree(const KeyframeGraph &graph, const LoopMatch &earlier, const LoopMatch
   const Eigen::Isometry2d placed_earlier = pose(earlier.candidate) * earlier.T_candidate_current;
   const Eigen::Isometry2d placed_later = pose(later.candidate) * later.T_candidate_current;
   const Eigen::Isometry2d tracked = pose(earlier.current).inverse() * pose(later.current);
-  return !distinct(placed_earlier.inverse() * placed_later, tracked, config.agreement_m, config.agreement_rad);
+  return !distinct(placed_earlier.inverse() * placed_later, tracked, config.agreement_m,
+                   config.agreement_rad);
 }
 
 }  // namespace omnislam::slam

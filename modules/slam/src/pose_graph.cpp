@@ -132,7 +132,8 @@ PoseGraphResult PoseGraph::optimize(const PoseGraphConfig &config) {
           new RelativePoseError(edge.T_from_to, edge.information));
       ceres::LossFunctionWrapper *loss = nullptr;
       if (edge.loop) {
-        loss = new ceres::LossFunctionWrapper(new ceres::CauchyLoss(config.loop_loss_scale), ceres::TAKE_OWNERSHIP);
+        loss = new ceres::LossFunctionWrapper(new ceres::CauchyLoss(config.loop_loss_scale),
+                                              ceres::TAKE_OWNERSHIP);
         losses.push_back(loss);
         largest_chi2 = std::max(largest_chi2, chi2(edge));
       }
@@ -158,9 +159,8 @@ PoseGraphResult PoseGraph::optimize(const PoseGraphConfig &config) {
     // Loop edges the solution cannot explain are outliers (false loop closures): drop them
     // and solve again without their pull.
     const auto before = edges_.size();
-    std::erase_if(edges_, [&](const PoseGraphEdge &edge) {
-      return edge.loop && chi2(edge) > config.loop_chi2_limit;
-    });
+    std::erase_if(
+        edges_, [&](const PoseGraphEdge &edge) { return edge.loop && chi2(edge) > config.loop_chi2_limit; });
     const auto removed = static_cast<int>(before - edges_.size());
     result.rejected_loops += removed;
     if (removed == 0) break;

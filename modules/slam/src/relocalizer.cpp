@@ -33,11 +33,12 @@ void Relocalizer::reset() {
 
 bool Relocalizer::same_pose(const Eigen::Isometry2d &a, const Eigen::Isometry2d &b) const {
   return (a.translation() - b.translation()).norm() <= config_.distinct_m &&
-         std::abs(std::remainder(yaw_rad_of(a) - yaw_rad_of(b), 2.0 * std::numbers::pi)) <= config_.distinct_rad;
+         std::abs(std::remainder(yaw_rad_of(a) - yaw_rad_of(b), 2.0 * std::numbers::pi)) <=
+             config_.distinct_rad;
 }
 
 std::optional<TrimmedIcpResult> Relocalizer::refine(const Points2 &scan_base,
-                                                     const Eigen::Isometry2d &guess) const {
+                                                    const Eigen::Isometry2d &guess) const {
   const TrimmedIcpResult fit = register_trimmed_icp(map_index_, scan_base, guess, config_.icp);
   if (!fit.valid || std::sqrt(fit.final_error_m2) > config_.max_rms_m ||
       fit.inlier_share < config_.min_inlier_share)
@@ -111,8 +112,9 @@ LocalizationResult Relocalizer::process(const Points2 &scan_base,
   std::vector<double> coarse_log_likelihood;
   double coarse_best = -std::numeric_limits<double>::infinity();
   for (const PoseCandidate &candidate : candidates) {
-    coarse_log_likelihood.push_back(config_.point_correlation *
-                                    search_matcher_.log_likelihood(scan_base, candidate.T_map_base, config_.outlier_share));
+    coarse_log_likelihood.push_back(
+        config_.point_correlation *
+        search_matcher_.log_likelihood(scan_base, candidate.T_map_base, config_.outlier_share));
     coarse_best = std::max(coarse_best, coarse_log_likelihood.back());
   }
   const std::size_t tracked = alive.size();

@@ -75,8 +75,8 @@ class Pipeline {
   /// for their pose on the map, and leave the SLAM stage with Frame::localized false until
   /// one pose is confirmed; from then on the SLAM continues from it on the saved map
   /// (slam::Slam::resume). Only before start().
-  void relocalize(std::vector<slam::MapPoint> points, int integrations, const slam::RelocalizerConfig &config = {},
-                  std::optional<slam::SearchWindow> window = {});
+  void relocalize(std::vector<slam::MapPoint> points, int integrations,
+                  const slam::RelocalizerConfig &config = {}, std::optional<slam::SearchWindow> window = {});
 
   /// Starts the five threads. Call once.
   void start(FrameSource source);

@@ -19,7 +19,7 @@
 namespace omnislam::slam {
 
 struct KeyframeConfig {
-  double keyframe_distance_m = 0.5;  ///< travel that makes the next integrated frame a keyframe
+  double keyframe_distance_m = 0.5;    ///< travel that makes the next integrated frame a keyframe
   double keyframe_angle_rad = 0.3491;  ///< or turn (20 deg)
   /// Standard deviation of a sequential edge: a floor (so an exact or degenerate fit never
   /// gives infinite confidence) plus drift_per_m per metre between the two keyframes.
@@ -31,7 +31,7 @@ struct KeyframeConfig {
 
 struct Keyframe {
   Eigen::Isometry2d T_map_keyframe = Eigen::Isometry2d::Identity();  ///< the graph's current value
-  double path_m = 0.0;                ///< distance travelled from the first keyframe
+  double path_m = 0.0;                  ///< distance travelled from the first keyframe
   std::vector<Points2> scans_keyframe;  ///< the integrated scans it holds, keyframe coordinates
 };
 

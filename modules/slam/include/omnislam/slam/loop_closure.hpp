@@ -35,7 +35,7 @@ struct LoopClosureConfig {
   /// The correlative search window: 3 sigma of the drift grown over the path gap
   /// (KeyframeConfig::drift_per_m, drift_yaw_per_m), clamped to these.
   double max_window_m = 1.0;
-  double max_window_rad = 0.1745;  ///< 10 deg
+  double max_window_rad = 0.1745;   ///< 10 deg
   double grid_resolution_m = 0.05;  ///< of the correlative search (and its scoring grid)
   int max_sample_points = 300;      ///< scored in the correlative search (evenly subsampled)
   /// Acceptance: the correlative score (mean likelihood of the points, 1 = all on the
@@ -81,8 +81,8 @@ struct LoopMatch {
   int current = -1;
   Eigen::Isometry2d T_candidate_current = Eigen::Isometry2d::Identity();
   Eigen::Matrix3d covariance = Eigen::Matrix3d::Identity();  ///< of T_candidate_current, with the floor
-  double score = 0.0;         ///< correlative, at the best pose
-  double second_score = 0.0;  ///< the best distinct pose or hypothesis
+  double score = 0.0;                                        ///< correlative, at the best pose
+  double second_score = 0.0;                                 ///< the best distinct pose or hypothesis
   TrimmedIcpResult registration;
 };
 
@@ -100,7 +100,8 @@ struct LoopMatch {
 /// the old path, with the path from the candidate to that loop's candidate plus the path
 /// travelled since that loop, if shorter.
 [[nodiscard]] LoopMatch search_loop(const KeyframeGraph &graph, const LoopClosureConfig &config,
-                                    const TrimmedIcpConfig &icp, const std::optional<LoopMatch> &last_loop = {});
+                                    const TrimmedIcpConfig &icp,
+                                    const std::optional<LoopMatch> &last_loop = {});
 
 /// Whether two loop matches of consecutive keyframes imply the same map correction.
 [[nodiscard]] bool agree(const KeyframeGraph &graph, const LoopMatch &earlier, const LoopMatch &later,

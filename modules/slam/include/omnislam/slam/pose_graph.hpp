@@ -30,8 +30,8 @@ struct PoseGraphEdge {
   int from = 0;
   int to = 0;
   Eigen::Isometry2d T_from_to = Eigen::Isometry2d::Identity();  ///< measured pose of `to` in `from`
-  Eigen::Matrix3d information = Eigen::Matrix3d::Identity();     ///< of (x, y, yaw) of T_from_to
-  bool loop = false;                                              ///< robust loss and chi-square test
+  Eigen::Matrix3d information = Eigen::Matrix3d::Identity();    ///< of (x, y, yaw) of T_from_to
+  bool loop = false;                                            ///< robust loss and chi-square test
 };
 
 struct PoseGraphResult {

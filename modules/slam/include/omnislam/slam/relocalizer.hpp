@@ -58,9 +58,9 @@ struct LocalizationResult {
   LocalizationState state = LocalizationState::kSearching;
   Eigen::Isometry2d T_map_base = Eigen::Isometry2d::Identity();  ///< when localized
   Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();          ///< of the last refinement (x, y, yaw)
-  int hypotheses = 0;        ///< alive after this frame
-  double best_score = 0.0;   ///< of the frame's best hypothesis
-  int searched_poses = 0;    ///< candidates the correlative search returned
+  int hypotheses = 0;                                            ///< alive after this frame
+  double best_score = 0.0;                                       ///< of the frame's best hypothesis
+  int searched_poses = 0;  ///< candidates the correlative search returned
 };
 
 class Relocalizer {
@@ -87,7 +87,7 @@ class Relocalizer {
   };
   /// ICP from `guess` against the map; nullopt when the fit is rejected.
   [[nodiscard]] std::optional<TrimmedIcpResult> refine(const Points2 &scan_base,
-                                                        const Eigen::Isometry2d &guess) const;
+                                                       const Eigen::Isometry2d &guess) const;
   [[nodiscard]] bool same_pose(const Eigen::Isometry2d &a, const Eigen::Isometry2d &b) const;
 
   RelocalizerConfig config_;

@@ -75,9 +75,9 @@ struct FrameEstimate {
   Attempt attempt = Attempt::kNone;
   TrimmedIcpResult registration;                         ///< the accepted one, or the last tried
   Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();  ///< (x, y, yaw) in the map frame
-  bool keyframe = false;      ///< the frame became a keyframe of the pose graph
-  bool loop_closed = false;   ///< a loop closure corrected the graph (and T_map_base) at this frame
-  bool map_rebuilt = false;   ///< ... and the map was rebuilt from the optimised keyframes
+  bool keyframe = false;                                 ///< the frame became a keyframe of the pose graph
+  bool loop_closed = false;  ///< a loop closure corrected the graph (and T_map_base) at this frame
+  bool map_rebuilt = false;  ///< ... and the map was rebuilt from the optimised keyframes
 };
 
 class Slam {
