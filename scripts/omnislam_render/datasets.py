@@ -17,7 +17,7 @@ from . import mirror as M
 from . import odometry as odo
 from . import pov
 from .geometry import Pose, compose, inverse, relative_to_first, write_tum, read_tum
-from .rooms import l_room, sim_room
+from .rooms import building_floor, l_room, sim_room
 from .rooms_real import l_room_real, office_real, sim_room_real
 from .scene import Room, frame_scene
 
@@ -100,6 +100,22 @@ def office_loop() -> list[Pose]:
     return facing_travel(_rectangle_loop(corners, [16, 6, 16, 6]))
 
 
+BUILDING_STEP_M = 0.25
+
+
+def building_loop(laps: int = 2, step: float = BUILDING_STEP_M) -> list[Pose]:
+    """Laps of one counter-clockwise loop on the building floor (rooms.building_floor), facing
+    the direction of travel: from (4, 1) east along the long corridor L to (19, 1), north up
+    the east corridor to (19, 7), west through room B, room A and their three doors to (1, 7),
+    south down the west corridor to (1, 1) and east back to (4, 1).  48 m a lap, cut into
+    steps of `step` metres (each leg a whole number of steps); the laps are joined and the
+    last pose is the first one again."""
+    corners = [(4.0, 1.0), (19.0, 1.0), (19.0, 7.0), (1.0, 7.0), (1.0, 1.0)]
+    legs = [math.hypot(b[0] - a[0], b[1] - a[1]) for a, b in zip(corners, corners[1:] + corners[:1])]
+    lap = _rectangle_loop(corners, [round(length / step) for length in legs])
+    return facing_travel(lap[:-1] * laps + lap[:1])
+
+
 DATASETS: dict[str, DatasetSpec] = {
     "sim-room-10": DatasetSpec("sim-room-10", sim_room, lambda: _still(table_points("3.1")), True,
                                "thesis simulated room, table 3.1 poses, constant heading"),
@@ -121,6 +137,10 @@ DATASETS: dict[str, DatasetSpec] = {
     "office-real": DatasetSpec("office-real", office_real, office_loop, False,
                                "office with carpet, pillar loop facing travel, camera 0.8 m up",
                                camera_height_m=0.8, grey=True),
+    # A flat-shaded building floor (grey PNGs to keep its ~400 frames small).
+    "building-2laps": DatasetSpec("building-2laps", building_floor, building_loop, False,
+                                  "building floor 20 x 12 m: corridors and two rooms, 2 laps of 48 m",
+                                  grey=True),
 }
 
 

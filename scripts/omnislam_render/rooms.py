@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import math
 
-from .scene import Box, Cylinder, Patch, Room, Sphere
+from .scene import Box, Cylinder, Floor, Patch, Room, Sphere
 
 # Plain, distinct colours (linear RGB).  The floor is dark so that every floor
 # contact (the nearest horizontal edges) has strong contrast.
@@ -109,3 +109,66 @@ def l_room() -> Room:
     lights = [((1.5, 1.5, 2.6), 0.6), ((4.0, 1.0, 2.8), 0.4)]
     walls = [WALLS[0], WALLS[1], WALLS[2], WALLS[3], WALLS[1], WALLS[2]]
     return Room("l-room", outline, walls, FLOOR, CEILING, 3.0, objects, patches, lights)
+
+
+# Building floor: walls in a few light tones, all of them far brighter than the floor.
+CORE = (0.78, 0.76, 0.72)
+PARTITION = (0.72, 0.78, 0.84)
+SHELF = (0.35, 0.30, 0.25)
+PILLAR = (0.85, 0.85, 0.80)
+
+
+def _wall(name: str, x0: float, y0: float, x1: float, y1: float, colour=PARTITION) -> Box:
+    """A wall or block standing on the floor (Floor raises it through the ceiling)."""
+    return Box(name, (x0, y0, 0.0), (x1, y1, 3.0), colour)
+
+
+def building_floor() -> Floor:
+    """A 20 x 12 m office floor (inside the outer walls: x 0..20, y 0..12), 3 m high.
+
+      long corridor L   y 0..2 along the south facade, x 0..20, 2 m wide; its north side is
+                        the core's plain face, 16 m long (x 2..18) without a door or niche
+      cross corridors   W at x 0..2 and E at x 18..20, 2 m wide, from L to the north facade
+      core              x 2..18, y 2..4.5: stairs, lifts and shafts, a solid block
+      room A (lab)      x 2.15..9.925, y 4.5..12, behind a 0.15 m partition to W
+      room B (office)   x 10.075..17.85, y 4.5..12, 0.15 m partitions to A and E
+      doors             1.4 m openings at y 6.3..7.7 in the three partitions W|A, A|B, B|E,
+                        in line, so a path along y = 7 crosses both rooms
+    Furniture keeps >= 0.5 m from the line y = 7 through the rooms: in A two four-legged
+    benches, a tall cabinet on the north wall, a low cabinet on the core and a crate; in B
+    two desks, a round table on a column, a bookshelf and a pillar; a cabinet closes the
+    dead end of E.  W and L hold nothing."""
+    door_lo, door_hi = 6.3, 7.7
+    solids = [
+        _wall("core", 2.0, 2.0, 18.0, 4.5, CORE),
+        _wall("partition W|A south", 2.0, 4.5, 2.15, door_lo, CORE),
+        _wall("partition W|A north", 2.0, door_hi, 2.15, 12.0, CORE),
+        _wall("partition A|B south", 9.925, 4.5, 10.075, door_lo),
+        _wall("partition A|B north", 9.925, door_hi, 10.075, 12.0),
+        _wall("partition B|E south", 17.85, 4.5, 18.0, door_lo, CORE),
+        _wall("partition B|E north", 17.85, door_hi, 18.0, 12.0, CORE),
+    ]
+    objects = [
+        # room A (lab)
+        *_table("bench 1", 3.0, 9.6, 6.0, 10.4),
+        *_table("bench 2", 6.6, 9.6, 9.2, 10.4),
+        Box("lab cabinet", (4.0, 11.5, 0.0), (6.0, 12.0, 1.8), CABINET),
+        Box("low cabinet", (6.5, 4.5, 0.0), (8.5, 5.0, 1.0), CABINET_2),
+        Box("crate", (3.0, 5.2, 0.0), (3.6, 5.8, 0.45), BOXES[0]),
+        # room B (office)
+        *_table("desk 1", 11.0, 9.0, 12.6, 9.8),
+        *_table("desk 2", 14.0, 9.0, 15.6, 9.8),
+        Box("round table top", (12.6, 5.2, 0.70), (13.4, 6.0, 0.75), TABLE_TOP),
+        Cylinder("round table column", (13.0, 5.6), 0.08, 0.0, 0.70, TABLE_FOOT),
+        Box("bookshelf", (17.45, 9.5, 0.0), (17.85, 11.5, 2.0), SHELF),
+        Cylinder("pillar", (16.0, 5.4), 0.2, 0.0, 3.0, PILLAR),
+        # dead end of the east corridor
+        Box("corridor cabinet", (18.4, 11.5, 0.0), (19.6, 12.0, 1.2), CABINET_2),
+    ]
+    # Shadowless point lights over the corridors and rooms (no falloff: they set the shading
+    # of each face orientation, like the two lights of the small rooms).
+    lights = [((x, y, 2.6), 0.14) for x, y in ((4.0, 1.0), (10.0, 1.0), (16.0, 1.0), (1.0, 8.0),
+                                                (19.0, 8.0), (6.0, 8.0), (14.0, 8.0))]
+    outline = [(0.0, 0.0), (20.0, 0.0), (20.0, 12.0), (0.0, 12.0)]  # outer walls: 0 south, 1 east, 2 north, 3 west
+    walls = [WALLS[0], WALLS[1], WALLS[0], WALLS[1]]
+    return Floor("building", outline, walls, FLOOR, CEILING, 3.0, objects, [], lights, solids=solids)

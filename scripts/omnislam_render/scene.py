@@ -337,3 +337,89 @@ def frame_scene(room: Room, pose: Pose, camera_height_m: float, camera: str, mir
         f"  {world_to_camera_matrix(pose, camera_height_m)}\n}}\n"
         + camera + mirror
     )
+
+
+def free_space_boundary(interior: tuple[float, float, float, float], solids: Sequence[Box]) -> list[Segment]:
+    """Where the free floor meets the solids, as maximal segments with the free side on their
+    left (counter-clockwise around the free space, like a room outline).
+
+    `interior` = (x0, y0, x1, y1), the inside of the outer walls; `solids` are the interior
+    walls and blocks (axis-aligned boxes standing on the floor); outside the interior counts
+    as solid.  The plan is cut into the cells of the grid through every box edge, each cell
+    free or solid; cell sides between a free and a solid cell are joined along their line."""
+    x0, y0, x1, y1 = interior
+    xs = sorted({x0, x1, *(min(max(v, x0), x1) for b in solids for v in (b.lo[0], b.hi[0]))})
+    ys = sorted({y0, y1, *(min(max(v, y0), y1) for b in solids for v in (b.lo[1], b.hi[1]))})
+
+    def free(i: int, j: int) -> bool:
+        if not (0 <= i < len(xs) - 1 and 0 <= j < len(ys) - 1):
+            return False
+        cx, cy = 0.5 * (xs[i] + xs[i + 1]), 0.5 * (ys[j] + ys[j + 1])
+        return not any(b.lo[0] < cx < b.hi[0] and b.lo[1] < cy < b.hi[1] for b in solids)
+
+    segments: list[Segment] = []
+    # Horizontal sides (y = ys[j]) between cell rows j-1 and j; free above -> run towards +x.
+    for j in range(len(ys)):
+        run = None      # (start x, direction)
+        for i in range(len(xs)):
+            kind = None
+            if i < len(xs) - 1:
+                below, above = free(i, j - 1), free(i, j)
+                kind = +1 if above and not below else (-1 if below and not above else None)
+            if run is not None and (kind != run[1]):
+                a, b = (run[0], xs[i]) if run[1] > 0 else (xs[i], run[0])
+                segments.append((a, ys[j], b, ys[j]))
+                run = None
+            if kind is not None and run is None:
+                run = (xs[i], kind)
+    # Vertical sides (x = xs[i]) between cell columns i-1 and i; free on the left of the
+    # direction: free to the west -> run towards +y, free to the east -> towards -y.
+    for i in range(len(xs)):
+        run = None
+        for j in range(len(ys)):
+            kind = None
+            if j < len(ys) - 1:
+                west, east = free(i - 1, j), free(i, j)
+                kind = +1 if west and not east else (-1 if east and not west else None)
+            if run is not None and (kind != run[1]):
+                a, b = (run[0], ys[j]) if run[1] > 0 else (ys[j], run[0])
+                segments.append((xs[i], a, xs[i], b))
+                run = None
+            if kind is not None and run is None:
+                run = (ys[j], kind)
+    return segments
+
+
+@dataclass
+class Floor(Room):
+    """A building floor: the outer walls around `outline` (an axis-aligned rectangle, the
+    inside of the outer walls) plus interior walls and solid blocks (`solids`, boxes from
+    below the floor to above the ceiling, each with its own colour).  The walls of the floor
+    plan are where the free floor meets them (free_space_boundary); doors are gaps between
+    wall boxes.  Box faces only ever touch solid neighbours, so no two visible surfaces are
+    coincident."""
+    solids: list[Box] = field(default_factory=list)
+
+    def _interior(self) -> tuple[float, float, float, float]:
+        xs = [p[0] for p in self.outline]
+        ys = [p[1] for p in self.outline]
+        if len(self.outline) != 4 or len(set(xs)) != 2 or len(set(ys)) != 2:
+            raise ValueError("a Floor's outline is the rectangle inside its outer walls")
+        return min(xs), min(ys), max(xs), max(ys)
+
+    def walls(self) -> list[Segment]:
+        return free_space_boundary(self._interior(), self.solids)
+
+    def _wall_boxes(self) -> list[str]:
+        t = WALL_THICKNESS
+        x0, y0, x1, y1 = self._interior()
+        outer = [((x0 - t, y0 - t), (x1 + t, y0)), ((x1, y0), (x1 + t, y1 + t)),
+                 ((x0 - t, y1), (x1, y1 + t)), ((x0 - t, y0), (x0, y1))]
+        out = []
+        for i, ((ax, ay), (bx, by)) in enumerate(outer):
+            colour = self.wall_colours[i % len(self.wall_colours)]
+            out.append(Box(f"outer wall {i}", (ax, ay, -t), (bx, by, self.height + t), colour).pov(self.finish))
+        for box in self.solids:
+            tall = Box(box.name, (box.lo[0], box.lo[1], -t), (box.hi[0], box.hi[1], self.height + t), box.colour)
+            out.append(tall.pov(self.finish))
+        return out

@@ -32,16 +32,21 @@ EXPECTED_POINTS = {
     "l-room-1lap-real": table_mm("3.3") + table_mm("3.3")[:1],
     # no table: the office loop is checked by test_office_loop_circles_the_pillar
     "office-real": [(x * 1000.0, y * 1000.0) for x, y, _ in datasets.office_loop()],
+    # no table: the building loop is checked by test_building_loop_two_laps_through_rooms
+    "building-2laps": [(x * 1000.0, y * 1000.0) for x, y, _ in datasets.building_loop()],
 }
 EXPECTED_FRAMES = {"sim-room-10": 10, "sim-room-37": 37, "sim-room-turning": 37,
                    "l-room-1lap": 60, "l-room-2laps": 119,
-                   "sim-room-37-real": 37, "l-room-1lap-real": 60, "office-real": 45}
+                   "sim-room-37-real": 37, "l-room-1lap-real": 60, "office-real": 45,
+                   "building-2laps": 385}
 # Datasets facing the direction of travel (heading not constant): no thesis odometry.txt.
-TURNING = {"sim-room-turning", "office-real"}
+TURNING = {"sim-room-turning", "office-real", "building-2laps"}
 CAMERA_HEIGHT_M = {"office-real": 0.8}      # the others 1.0
 # Realistic datasets (rooms_real.py), their flat twin (same geometry) and the floor pattern.
 REALISTIC = {"sim-room-37-real": ("sim-room-37", "cells"), "l-room-1lap-real": ("l-room-1lap", "brick"),
              "office-real": (None, "hexagon")}
+# Flat-shaded datasets stored as grey PNGs (too many frames for RGB).
+GREY_FLAT = {"building-2laps"}
 SKIRTING_DEPTH_M = 0.012
 METADATA_FILES = ["groundtruth.tum", "odometry.tum", "odometry_exact.tum", "odometry.txt", "floorplan.csv",
                   "dataset.yaml"]
@@ -87,7 +92,8 @@ def test_groundtruth_reproduces_trajectory_table(metadata_dir, name):
             assert abs(yaw) < 1e-12
 
 
-@pytest.mark.parametrize("name, corners, min_facing", [("sim-room-turning", 4, 20), ("office-real", 3, 30)])
+@pytest.mark.parametrize("name, corners, min_facing", [("sim-room-turning", 4, 20), ("office-real", 3, 30),
+                                                        ("building-2laps", 8, 300)])
 def test_turning_headings_face_travel_and_turn_smoothly(metadata_dir, name, corners, min_facing):
     gt = poses(metadata_dir / name / "groundtruth.tum")
     yaw_steps = [abs(angle_diff(b[2], a[2])) for a, b in zip(gt[:-1], gt[1:])]
@@ -125,6 +131,67 @@ def test_office_loop_circles_the_pillar():
     turns = [angle_diff(b[2], a[2]) for a, b in zip(world[:-1], world[1:])]
     assert min(turns) >= -1e-12
     assert sum(turns) == pytest.approx(math.radians(270.0), abs=1e-9)
+
+
+def test_building_loop_two_laps_through_rooms():
+    """building-2laps: two identical counter-clockwise laps of 48 m (>= 80 m in all) in
+    0.25 m steps, back to the first pose; each lap runs the long corridor, the east corridor,
+    both rooms through their three doors and the west corridor."""
+    spec = datasets.DATASETS["building-2laps"]
+    world = spec.world_poses()
+    assert len(world) == 385
+    # lap 2 repeats lap 1 (headings up to rounding: its images are lap 1's)
+    for p, q in zip(world[:193], world[192:]):
+        assert p[:2] == q[:2] and abs(angle_diff(p[2], q[2])) < 1e-12
+    lengths = [math.hypot(b[0] - a[0], b[1] - a[1]) for a, b in zip(world[:-1], world[1:])]
+    assert lengths == pytest.approx([0.25] * 384, abs=1e-9)
+    assert sum(lengths) == pytest.approx(96.0, abs=1e-6) and sum(lengths) >= 80.0
+    turns = [angle_diff(b[2], a[2]) for a, b in zip(world[:-1], world[1:])]
+    assert min(turns) >= -1e-12 and sum(turns) == pytest.approx(4 * math.pi, abs=1e-9)
+    lap = world[:193]
+    # through the three doors (partition x: W|A 2.0-2.15, A|B 9.925-10.075, B|E 17.85-18.0),
+    # openings y 6.3..7.7
+    for x_door in (2.075, 10.0, 17.925):
+        crossing = [(a, b) for a, b in zip(lap[:-1], lap[1:]) if min(a[0], b[0]) <= x_door <= max(a[0], b[0])
+                    and 4.5 < a[1] < 12.0]
+        assert crossing and all(6.3 + 0.45 <= a[1] <= 7.7 - 0.45 for a, _ in crossing)
+    room = spec.room()
+    in_room = {name: sum(1 for x, y, _ in lap if x0 < x < x1 and y > 4.5)
+               for name, x0, x1 in (("A", 2.15, 9.925), ("B", 10.075, 17.85))}
+    assert min(in_room.values()) >= 25
+    assert max(x for x, _, _ in lap) - min(x for x, _, _ in lap) == pytest.approx(18.0)
+    assert room.height == 3.0 and spec.camera_height_m == 1.0
+
+
+def test_building_long_corridor_is_plain():
+    """Along the middle of the long corridor every wall or object in sight within the stereo
+    range (6 m) runs along the corridor: nothing there fixes the motion along it."""
+    spec = datasets.DATASETS["building-2laps"]
+    room = spec.room()
+    segments = room.floorplan()
+
+    def blocked(x0, y0, x1, y1):
+        """Does the sight line from (x0, y0) to just before (x1, y1) cross a wall block?"""
+        for t in np.linspace(0.0, 0.995, 60):
+            x, y = x0 + t * (x1 - x0), y0 + t * (y1 - y0)
+            if any(b.lo[0] < x < b.hi[0] and b.lo[1] < y < b.hi[1] for b in room.solids):
+                return True
+        return False
+
+    middle = [p for p in spec.world_poses() if p[1] == 1.0 and 8.0 <= p[0] <= 12.0]
+    assert len(middle) == 2 * 17
+    seen = set()
+    for x, y, yaw in middle:
+        assert abs(yaw) < 1e-12
+        for seg in segments:
+            x1, y1, x2, y2 = seg
+            for t in np.linspace(0.0, 1.0, 41):
+                px, py = x1 + t * (x2 - x1), y1 + t * (y2 - y1)
+                if math.hypot(px - x, py - y) < 6.0 and not blocked(x, y, px, py):
+                    assert y1 == y2, (x, seg)
+                    seen.add(seg)
+    # in sight: only the corridor's two walls, the facade and the core's face, 16 m without a gap
+    assert seen == {(0.0, 0.0, 20.0, 0.0), (18.0, 2.0, 2.0, 2.0)}
 
 
 @pytest.mark.parametrize("name", DATASET_NAMES)
@@ -297,6 +364,36 @@ def test_floorplan_office(metadata_dir):
         assert segs[28 + 4 * k:32 + 4 * k] == pytest.approx(np.array(rect), abs=2e-9), f"box {k}"
 
 
+def test_floorplan_building(metadata_dir):
+    segs = _floorplan(metadata_dir / "building-2laps" / "floorplan.csv")
+    # map frame = pose 1 at room (4, 1), heading east: the 20 x 12 m floor spans
+    # x -4..16, y -1..11
+    walls = segs[:28]
+    assert walls[:, [0, 2]].min() == pytest.approx(-4.0) and walls[:, [0, 2]].max() == pytest.approx(16.0)
+    assert walls[:, [1, 3]].min() == pytest.approx(-1.0) and walls[:, [1, 3]].max() == pytest.approx(11.0)
+    # 28 wall segments, 22 boxes (four 4-legged tables and six others) and 2 circles
+    assert len(segs) == 28 + 4 * (4 * 5 + 6) + 24 * 2
+    # every wall segment has free floor on its left and a solid on its right (the core, a
+    # partition, or the outer walls beyond the floor's outline)
+    room = datasets.DATASETS["building-2laps"].room()
+    for x1, y1, x2, y2 in room.walls():
+        mx, my = 0.5 * (x1 + x2), 0.5 * (y1 + y2)
+        nx, ny = -(y2 - y1), x2 - x1          # left of the segment: the free side
+        n = math.hypot(nx, ny)
+        fx, fy = mx + 0.01 * nx / n, my + 0.01 * ny / n
+        assert 0.0 < fx < 20.0 and 0.0 < fy < 12.0
+        assert not any(b.lo[0] < fx < b.hi[0] and b.lo[1] < fy < b.hi[1] for b in room.solids)
+        sx, sy = mx - 0.01 * nx / n, my - 0.01 * ny / n
+        assert not (0.0 < sx < 20.0 and 0.0 < sy < 12.0) or any(
+            b.lo[0] < sx < b.hi[0] and b.lo[1] < sy < b.hi[1] for b in room.solids)
+    # facades 2 x (20 + 12) less the three partition ends on the north one, the core's
+    # south face (16), its west and east ends continued by the partitions (4 x 4.3, cut by
+    # the doors), its north face in both rooms (2 x 7.775), the partitions' room faces
+    # (4 x 6.1) and six door jambs
+    length = sum(math.hypot(x2 - x1, y2 - y1) for x1, y1, x2, y2 in room.walls())
+    assert length == pytest.approx(64.0 - 3 * 0.15 + 16.0 + 4 * 4.3 + 2 * 7.775 + 4 * 6.1 + 6 * 0.15)
+
+
 def test_frames_option_limits_metadata(tmp_path):
     out = tmp_path / "ds"
     subprocess.run(RENDER + ["l-room-2laps", "--out", str(out), "--frames", "7", "--no-images"],
@@ -362,7 +459,7 @@ def test_realistic_room_scene_parts(name):
 @pytest.mark.parametrize("name", [n for n in DATASET_NAMES if n not in REALISTIC])
 def test_flat_rooms_have_no_realistic_parts(name):
     spec = datasets.DATASETS[name]
-    assert not spec.grey
+    assert spec.grey == (name in GREY_FLAT)
     body = spec.room().pov_body()
     for part in ("area_light", "projected_through", "// skirting", "texture", "no_shadow"):
         assert part not in body
