@@ -2,6 +2,7 @@
 #include <catch2/catch.hpp>
 #include <chrono>
 #include <filesystem>
+#include <optional>
 #include <thread>
 #include <vector>
 
@@ -10,6 +11,7 @@
 #include "omnislam/io/image_file.hpp"
 #include "omnislam/io/poses.hpp"
 #include "omnislam/pipeline/pipeline.hpp"
+#include "omnislam/slam/planar_pose.hpp"
 #include "omnislam/stereo/scan_reconstructor.hpp"
 
 // The staged pipeline on the rendered dataset against a sequential reference: the same
@@ -153,4 +155,80 @@ TEST_CASE("live pipeline with a slow consumer: drops, bounded, still follows the
     max_error_m = std::max(max_error_m, (estimate_out[i].translation() - truth_map.translation()).norm());
   }
   CHECK(max_error_m < 0.1);
+}
+
+namespace {
+
+// Frames first..kFrames-1 from memory, the first one carrying `rough` as an operator's pose.
+pipeline::FrameSource source_from(const Input &in, int first,
+                                  std::optional<pipeline::Frame::PoseReset> rough) {
+  auto next = std::make_shared<int>(first);
+  return [&in, next, rough, first]() -> pipeline::FramePtr {
+    if (*next >= kFrames) return nullptr;
+    const auto i = static_cast<std::size_t>(*next);
+    auto frame = std::make_unique<pipeline::Frame>();
+    frame->stamp_s = static_cast<double>(i);
+    frame->image = in.images[i];
+    frame->T_odom_base = in.odometry[i];
+    frame->has_odometry = true;
+    if (rough && static_cast<int>(i) == first) frame->pose_reset = rough;
+    ++*next;
+    return frame;
+  };
+}
+
+struct Localized {
+  int frames = 0;
+  int without_pose = 0;
+  double worst_error_m = 0.0;
+};
+
+Localized relocalised(const Input &in, const std::vector<slam::MapPoint> &map,
+                      std::optional<pipeline::Frame::PoseReset> rough = {}) {
+  Localized result;
+  const Eigen::Isometry2d T_truth_map = in.ground_truth.front();  // the map frame: frame 1's pose
+  pipeline::Sinks sinks;
+  sinks.frame = [&](const pipeline::Frame &f) {
+    ++result.frames;
+    if (!f.localized) {
+      ++result.without_pose;
+      return;
+    }
+    const Eigen::Isometry2d truth =
+        T_truth_map.inverse() * in.ground_truth[static_cast<std::size_t>(f.stamp_s)];
+    result.worst_error_m =
+        std::max(result.worst_error_m, (truth.translation() - f.estimate.T_map_base.translation()).norm());
+  };
+  slam::SlamConfig slam;
+  slam.localization_only = true;
+  pipeline::Pipeline pipeline(in.scan, slam, {}, sinks);
+  pipeline.relocalize(map, kFrames);
+  pipeline.run(source_from(in, 4, rough));
+  return result;
+}
+
+}  // namespace
+
+TEST_CASE("relocalising pipeline: its pose found on a saved map, an operator's pose as a search window") {
+  const Input &in = input();
+  const std::vector<slam::MapPoint> map = pipelined(in).map;
+  const Localized found = relocalised(in, map);
+  CHECK(found.frames == kFrames - 4);
+  CHECK(found.without_pose == 2);  // confirmed on the third frame
+  CHECK(found.worst_error_m < 0.03);
+
+  const Eigen::Isometry2d truth = in.ground_truth.front().inverse() * in.ground_truth[4];
+  SECTION("a rough pose near the truth still finds it") {
+    const Localized near = relocalised(in, map,
+                                       pipeline::Frame::PoseReset{truth * slam::planar_pose(0.3, -0.2, 0.1),
+                                                                  Eigen::Matrix3d::Identity() * 0.04});
+    CHECK(near.without_pose == 2);
+    CHECK(near.worst_error_m < 0.03);
+  }
+  SECTION("a rough pose whose window excludes the truth finds nothing") {
+    const Localized far = relocalised(in, map,
+                                      pipeline::Frame::PoseReset{truth * slam::planar_pose(1.5, 0.0, 0.0),
+                                                                 Eigen::Matrix3d::Identity() * 0.01});
+    CHECK(far.without_pose == kFrames - 4);
+  }
 }
