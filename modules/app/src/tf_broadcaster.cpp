@@ -32,8 +32,9 @@ void TfBroadcaster::update(double stamp_s, const Eigen::Isometry2d &T_map_base,
     if (config_.publish_odom_to_base)
       transforms_.push_back({config_.odom_frame, config_.base_frame, *T_odom_base});
   }  // else a gap in the odometry: the last transforms stay
-  data_step_s_ = stamp_s > stamp_s_ ? stamp_s - stamp_s_ : 0.0;
+  data_step_s_ = stamped_ && stamp_s > stamp_s_ ? stamp_s - stamp_s_ : 0.0;
   stamp_s_ = stamp_s;
+  stamped_ = true;
   stamped_at_ = Clock::now();
   publish_locked(stamp_s);
 }
@@ -56,9 +57,10 @@ void TfBroadcaster::resend_loop(const std::stop_token &stop) {
     wake_.wait_until(lock, stop, deadline, [] { return false; });
     if (stop.stop_requested()) break;
     // Never past where the next frame is due (a dataset played slower than recorded would
-    // otherwise send stamps beyond the next frame's, and they would run backwards).
-    double elapsed_s = std::chrono::duration<double>(Clock::now() - stamped_at_).count();
-    if (data_step_s_ > 0.0) elapsed_s = std::min(elapsed_s, data_step_s_);
+    // otherwise send stamps beyond the next frame's, and they would run backwards); before
+    // the second frame that is unknown, and re-sends repeat the frame's own stamp.
+    const double elapsed_s =
+        std::min(std::chrono::duration<double>(Clock::now() - stamped_at_).count(), data_step_s_);
     publish_locked(stamp_s_ + elapsed_s);
   }
 }

@@ -43,6 +43,7 @@ class TfBroadcaster {
   std::condition_variable_any wake_;
   std::vector<dds::FrameTransform> transforms_;  ///< the last ones sent (empty before a frame)
   double stamp_s_ = 0.0;                         ///< data time of the last frame
+  bool stamped_ = false;                         ///< a frame has come
   double data_step_s_ = 0.0;                     ///< data time between the last two frames
   Clock::time_point stamped_at_;                 ///< when that frame arrived
   std::jthread thread_;
