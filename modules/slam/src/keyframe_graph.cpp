@@ -8,13 +8,6 @@
 namespace omnislam::slam {
 namespace {
 
-Points2 transformed(const Points2 &points, const Eigen::Isometry2d &T) {
-  Points2 out;
-  out.reserve(points.size());
-  for (const Point2 &p : points) out.push_back(T * p);
-  return out;
-}
-
 // A (x, y, yaw) covariance given in the map frame, expressed in a frame turned by R.
 Eigen::Matrix3d in_frame(const Eigen::Matrix3d &covariance_map, const Eigen::Matrix2d &R_map_frame) {
   Eigen::Matrix3d rotate = Eigen::Matrix3d::Identity();

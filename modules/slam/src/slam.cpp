@@ -8,13 +8,6 @@
 namespace omnislam::slam {
 namespace {
 
-Points2 transformed(const Points2 &points, const Eigen::Isometry2d &T) {
-  Points2 out;
-  out.reserve(points.size());
-  for (const Point2 &p : points) out.push_back(T * p);
-  return out;
-}
-
 // Odometry uncertainty of one step, used to grow the covariance of unregistered frames
 // (the thesis noise model: 10% of the distance, 1.5 deg of heading).
 Eigen::Matrix3d odometry_step_covariance(const Eigen::Isometry2d &step) {

@@ -3,6 +3,8 @@
 #include <Eigen/Geometry>
 #include <cmath>
 
+#include "omnislam/slam/nearest_neighbors.hpp"
+
 /// @file
 /// Planar poses (x, y, yaw about z) as Eigen::Isometry2d.
 
@@ -19,6 +21,14 @@ namespace omnislam::slam {
   T.linear() = Eigen::Rotation2Dd(yaw_rad).toRotationMatrix();
   T.translation() = Eigen::Vector2d(x_m, y_m);
   return T;
+}
+
+/// The points moved by `T` (base_link -> map, keyframe -> map, ...).
+[[nodiscard]] inline Points2 transformed(const Points2 &points, const Eigen::Isometry2d &T) {
+  Points2 out;
+  out.reserve(points.size());
+  for (const Point2 &p : points) out.push_back(T * p);
+  return out;
 }
 
 }  // namespace omnislam::slam
