@@ -81,6 +81,10 @@ LoopRun run_slam(const SlamConfig &config, const std::vector<Segment> &walls,
   for (std::size_t i = 0; i < truth.size(); ++i) {
     const FrameEstimate estimate = slam.process(omnislam::test::scan_from(walls, truth[i], rng), odometry[i]);
     run.truth.push_back(truth.front().inverse() * truth[i]);
+    // Each frame knows its entry in the trajectory; after a correction that entry is the
+    // frame's (corrected) pose, which is what the occupancy grid is rebuilt with.
+    REQUIRE(estimate.trajectory_index == static_cast<int>(i));
+    if (estimate.map_rebuilt) CHECK(slam.trajectory()[i].isApprox(estimate.T_map_base, 1e-12));
     if (estimate.keyframe) run.keyframe_frame.push_back(static_cast<int>(i));
     run.online_max_m = std::max(run.online_max_m,
                                 (estimate.T_map_base.translation() - run.truth.back().translation()).norm());

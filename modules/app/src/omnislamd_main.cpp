@@ -20,7 +20,7 @@
 #include "frame_record.hpp"
 #include "omnislam/dds/odometry_reader.hpp"
 #include "omnislam/dds/publisher.hpp"
-#include "omnislam/grid/occupancy_grid.hpp"
+#include "omnislam/grid/trajectory_grid.hpp"
 #include "omnislam/io/config.hpp"
 #include "omnislam/io/grid_files.hpp"
 #include "omnislam/pipeline/pipeline.hpp"
@@ -165,7 +165,9 @@ int run_service(const std::string &config_file) {
   RunRecord run;
   bool posed = !search_start;  // a frame has had a pose (set by the publish thread; read after join)
   std::uint64_t not_localized = 0;
-  grid::OccupancyGrid occupancy;  // rt/map, snapshots, and map.yaml + map.pgm in output_dir
+  // rt/map, snapshots, and map.yaml + map.pgm in output_dir; rebuilt when a loop closure
+  // corrects the poses it was built with.
+  grid::TrajectoryGrid occupancy;
   if (resumed && resumed->grid) {
     if (std::abs(resumed->grid->resolution_m - occupancy.config().resolution_m) < 1e-9)
       occupancy.seed(*resumed->grid);
@@ -215,8 +217,10 @@ int run_service(const std::string &config_file) {
         publisher->status({system_time_s(), dds::ServiceState::kRunning, frame.sequence, 0, 0, ""});
     }
     const bool gridded = publisher || !service.output_dir.empty() || snapshots;
+    if (gridded && frame.trajectory) occupancy.rebuild(*frame.trajectory);
     if (gridded && !frame.skipped())
-      occupancy.add_scan(frame.estimate.T_map_base, scan_rays(frame.scan, config.scan.camera));
+      occupancy.add_scan(frame.estimate.trajectory_index, frame.estimate.T_map_base,
+                         scan_rays(frame.scan, config.scan.camera));
     if (tf)
       tf->update(frame.stamp_s, frame.estimate.T_map_base,
                  frame.has_odometry ? std::optional(frame.T_odom_base) : std::nullopt);
@@ -293,6 +297,7 @@ int run_service(const std::string &config_file) {
   if (status.last_error.empty()) status.last_error = initial_pose_counts->last_error();
   status.state = pipeline.error().empty() ? dds::ServiceState::kStopped : dds::ServiceState::kFailed;
   const double last_stamp = last_frame ? last_frame->t_s : status.stamp_s;
+  occupancy.rebuild(pipeline.slam().trajectory());       // at the final poses, as trajectory.tum
   const grid::GridImage final_grid = occupancy.image();  // empty when nothing was gridded
   if (snapshots && last_frame) {
     // The final state, written before anything else can fail.

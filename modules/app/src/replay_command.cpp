@@ -11,7 +11,7 @@
 #include "dataset_source.hpp"
 #include "degradation_options.hpp"
 #include "frame_record.hpp"
-#include "omnislam/grid/occupancy_grid.hpp"
+#include "omnislam/grid/trajectory_grid.hpp"
 #include "omnislam/io/config.hpp"
 #include "omnislam/io/dataset.hpp"
 #include "omnislam/io/grid_files.hpp"
@@ -77,13 +77,14 @@ void run_replay(const ReplayOptions &options, std::optional<std::uint64_t> degra
   pipeline_config.mode = pipeline::Mode::kReplay;
   pipeline_config.map_every_integration = true;  // the thesis's mapaN.txt after every image
   pipeline::Sinks sinks;
-  // The occupancy grid of the run (map.yaml + map.pgm): every frame's boundary points and
-  // free floor at the pose it was given.
-  grid::OccupancyGrid occupancy;
+  // The occupancy grid of the run (map.yaml + map.pgm): the frames' boundary points and free
+  // floor, built at the end from the final (optimised) poses of trajectory.tum.
+  grid::TrajectoryGrid occupancy;
   sinks.frame = [&](const pipeline::Frame &frame) {
     run.frames.push_back(frame_record(frame));
     if (!frame.skipped() && frame.localized)
-      occupancy.add_scan(frame.estimate.T_map_base, scan_rays(frame.scan, config.scan.camera));
+      occupancy.add_scan(frame.estimate.trajectory_index, frame.estimate.T_map_base,
+                         scan_rays(frame.scan, config.scan.camera));
     if (frame.estimate.integrated && frame.map)
       writer.write_thesis_map(static_cast<int>(frame.sequence), *frame.map);
   };
@@ -120,6 +121,7 @@ void run_replay(const ReplayOptions &options, std::optional<std::uint64_t> degra
                   options.map_file.c_str(), first - run.frames.begin() + 1, first - run.frames.begin());
     }
   }
+  occupancy.rebuild(pipeline.slam().trajectory());
   const grid::GridImage grid_image = occupancy.image();
   if (grid_image.width > 0)
     io::write_nav2_map(std::filesystem::path(options.out_dir) / "map.yaml", grid_image);

@@ -299,6 +299,8 @@ void Pipeline::slam_loop() {
         frame->map = std::make_shared<const std::vector<slam::MapPoint>>(slam_.map().points());
         last_map = now;
       }
+      if (frame->estimate.map_rebuilt)
+        frame->trajectory = std::make_shared<const std::vector<Eigen::Isometry2d>>(slam_.trajectory());
     }
     if (config_.state_period_s > 0.0 &&
         now - last_state >= std::chrono::duration<double>(config_.state_period_s)) {

@@ -145,6 +145,7 @@ FrameEstimate Slam::seed_map(const Points2 &scan_base) {
   } else {
     keyframes_.add_pose(previous_.T_map_base);
   }
+  previous_.trajectory_index = keyframes_.frame_count() - 1;
   return previous_;
 }
 
@@ -245,6 +246,7 @@ FrameEstimate Slam::process(const Points2 &scan_base, const std::optional<Eigen:
     estimate.covariance = previous_.covariance + rotate * odometry_step_covariance(step) * rotate.transpose();
   }
   if (!in_graph) keyframes_.add_pose(estimate.T_map_base);
+  estimate.trajectory_index = keyframes_.frame_count() - 1;
   previous_failed_ = !estimate.integrated;
   if (T_odom_base) set_anchor(*T_odom_base, estimate.T_map_base);
   last_step_ = previous_.T_map_base.inverse() * estimate.T_map_base;  // extrapolated through gaps

@@ -74,6 +74,8 @@ class KeyframeGraph {
   [[nodiscard]] std::vector<Eigen::Isometry2d> trajectory() const;
 
   [[nodiscard]] const std::vector<Keyframe> &keyframes() const { return keyframes_; }
+  /// How many frames are recorded (trajectory()'s size).
+  [[nodiscard]] int frame_count() const { return static_cast<int>(frames_.size()); }
   [[nodiscard]] int last() const { return static_cast<int>(keyframes_.size()) - 1; }
   [[nodiscard]] const PoseGraph &graph() const { return graph_; }
   [[nodiscard]] const KeyframeConfig &config() const { return config_; }

@@ -78,6 +78,9 @@ struct FrameEstimate {
   bool keyframe = false;                                 ///< the frame became a keyframe of the pose graph
   bool loop_closed = false;  ///< a loop closure corrected the graph (and T_map_base) at this frame
   bool map_rebuilt = false;  ///< ... and the map was rebuilt from the optimised keyframes
+  /// This frame's index in Slam::trajectory() (-1: not recorded there, e.g. the frame a
+  /// relocalisation confirmed; the trajectory starts afresh at resume()).
+  int trajectory_index = -1;
 };
 
 class Slam {

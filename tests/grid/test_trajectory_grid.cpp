@@ -1,0 +1,116 @@
+#include <catch2/catch.hpp>
+#include <cmath>
+#include <numbers>
+#include <vector>
+
+#include "omnislam/grid/trajectory_grid.hpp"
+
+using omnislam::grid::GridImage;
+using omnislam::grid::Ray;
+using omnislam::grid::TrajectoryGrid;
+
+namespace {
+
+// A scan from `T_map_base` inside the square room [-2, 2] x [-2, 2] m: one ray per degree,
+// hitting the wall, the floor seen free up to it.
+std::vector<Ray> room_scan(const Eigen::Isometry2d &T_map_base) {
+  std::vector<Ray> rays;
+  const Eigen::Vector2d origin = T_map_base.translation();
+  const double yaw = std::atan2(T_map_base.linear()(1, 0), T_map_base.linear()(0, 0));
+  for (int degree = 0; degree < 360; ++degree) {
+    const double azimuth = degree * std::numbers::pi / 180.0;
+    const Eigen::Vector2d direction(std::cos(yaw + azimuth), std::sin(yaw + azimuth));
+    double range = 1e9;
+    for (int axis = 0; axis < 2; ++axis) {
+      if (std::abs(direction[axis]) < 1e-12) continue;
+      const double wall = direction[axis] > 0.0 ? 2.0 : -2.0;
+      range = std::min(range, (wall - origin[axis]) / direction[axis]);
+    }
+    rays.push_back({azimuth, range, range});
+  }
+  return rays;
+}
+
+Eigen::Isometry2d pose(double x, double y, double yaw) {
+  return Eigen::Translation2d(x, y) * Eigen::Rotation2Dd(yaw);
+}
+
+// Occupied cells farther than `tolerance_m` from the room's walls.
+int off_wall(const GridImage &image, double tolerance_m) {
+  int count = 0;
+  for (int y = 0; y < image.height; ++y) {
+    for (int x = 0; x < image.width; ++x) {
+      if (image.cells[static_cast<std::size_t>(y * image.width + x)] != 100) continue;
+      const Eigen::Vector2d centre =
+          image.origin_m + (Eigen::Vector2d(x, y).array() + 0.5).matrix() * image.resolution_m;
+      const double to_wall = 2.0 - centre.cwiseAbs().maxCoeff();
+      count += std::abs(to_wall) > tolerance_m ? 1 : 0;
+    }
+  }
+  return count;
+}
+
+}  // namespace
+
+TEST_CASE("trajectory grid: scans that cannot change the grid are not kept", "[grid]") {
+  TrajectoryGrid grid;  // 0.05 m cells
+  CHECK(grid.add_scan(0, pose(0.0, 0.0, 0.0), room_scan(pose(0.0, 0.0, 0.0))));
+  // Standing still, or moving less than a cell: nothing new.
+  CHECK_FALSE(grid.add_scan(1, pose(0.0, 0.0, 0.0), room_scan(pose(0.0, 0.0, 0.0))));
+  CHECK_FALSE(grid.add_scan(2, pose(0.03, 0.0, 0.0), room_scan(pose(0.03, 0.0, 0.0))));
+  // The longest ray reaches a corner, 2.83 m: a turn moves its end by a cell at 1 deg.
+  CHECK_FALSE(
+      grid.add_scan(3, pose(0.0, 0.0, 0.5 * std::numbers::pi / 180.0), room_scan(pose(0.0, 0.0, 0.0))));
+  CHECK(grid.add_scan(4, pose(0.0, 0.0, 1.2 * std::numbers::pi / 180.0), room_scan(pose(0.0, 0.0, 0.0))));
+  CHECK(grid.add_scan(5, pose(0.06, 0.0, 0.0), room_scan(pose(0.06, 0.0, 0.0))));
+  CHECK(grid.kept_scans() == 3u);
+}
+
+TEST_CASE("trajectory grid: rebuilt from corrected poses, the walls move to where they are", "[grid]") {
+  // The robot crosses the room; its poses drift 1 cm per step in y (a loop closure later
+  // finds the true ones). The scans are what it saw from the true poses.
+  std::vector<Eigen::Isometry2d> truth, drifted;
+  TrajectoryGrid grid;
+  for (int step = 0; step < 30; ++step) {
+    truth.push_back(pose(-1.5 + 0.1 * step, 0.0, 0.02 * step));
+    drifted.push_back(pose(-1.5 + 0.1 * step, 0.01 * step, 0.02 * step));
+    grid.add_scan(step, drifted.back(), room_scan(truth.back()));
+  }
+  const GridImage before = grid.image();
+  CHECK(off_wall(before, 0.1) > 50);  // walls smeared by up to 0.29 m
+
+  SECTION("the same poses give the same grid, cell for cell") {
+    grid.rebuild(drifted);
+    const GridImage again = grid.image();
+    CHECK(again.width == before.width);
+    CHECK(again.height == before.height);
+    CHECK(again.origin_m.isApprox(before.origin_m));
+    CHECK(again.cells == before.cells);
+  }
+  SECTION("the corrected poses put every occupied cell on a wall") {
+    grid.rebuild(truth);
+    CHECK(off_wall(grid.image(), 0.05) == 0);
+  }
+  SECTION("a scan of a frame the trajectory does not hold keeps its pose") {
+    grid.rebuild(std::vector<Eigen::Isometry2d>(truth.begin(), truth.begin() + 10));
+    CHECK(off_wall(grid.image(), 0.1) > 0);
+  }
+}
+
+TEST_CASE("trajectory grid: a seed from a snapshot stays under every rebuild", "[grid]") {
+  GridImage seed;
+  seed.width = 2;
+  seed.height = 1;
+  seed.resolution_m = 0.05;
+  seed.origin_m = Eigen::Vector2d(10.0, 10.0);  // far from anything the scans see
+  seed.cells = {100, 0};
+  TrajectoryGrid grid;
+  grid.seed(seed);
+  grid.add_scan(0, pose(0.0, 0.0, 0.0), room_scan(pose(0.0, 0.0, 0.0)));
+  grid.rebuild(std::vector<Eigen::Isometry2d>{pose(0.0, 0.0, 0.0)});
+  const GridImage image = grid.image();
+  const int x = static_cast<int>(std::lround((10.0 - image.origin_m.x()) / image.resolution_m));
+  const int y = static_cast<int>(std::lround((10.0 - image.origin_m.y()) / image.resolution_m));
+  CHECK(image.cells[static_cast<std::size_t>(y * image.width + x)] == 100);
+  CHECK(image.cells[static_cast<std::size_t>(y * image.width + x + 1)] == 0);
+}
