@@ -22,10 +22,15 @@ constexpr float kRadiusUnitPx = 512.0f;
 constexpr float kMaxRowVote = 3.0f;
 constexpr float kRowCorrelation = 0.5f;
 constexpr float kDeadZone = 2.0f;  // in units of the residual scale
+// Beyond the dead zone and the cap, a residual is larger than a row's vote can explain.
+constexpr float kOutlierResidual = kDeadZone + kMaxRowVote;
 // The 7 x 3 similarity window's pixels share the smoothing in both directions.
 constexpr float kWindowCorrelation = 0.25f;
 // An edge spreads over +-3 rows after the detector's and the residual's smoothing.
 constexpr int kEdgeBlurRows = 3;
+// An edge's outer twin on the floor is sought this far from the floor's row when the frame's
+// sub-pixel placement error is measured (several times any spread seen).
+constexpr float kTwinSearchRows = 2.5f;
 
 int polarity(const vision::EdgeImage &edges, int row, int column) {
   return edges.grad_row.at<std::int16_t>(row, column) >= 0 ? 1 : -1;
@@ -176,6 +181,9 @@ float FloorBoundaryFinder::window_deviation(int inner_row, int column,
 }
 
 float FloorBoundaryFinder::row_vote(float residual_against, float residual_for) const {
+  // A row neither hypothesis explains (a dust speck, a highlight, a third surface in
+  // between) is an outlier under both: it says nothing about which is right.
+  if (std::min(residual_against, residual_for) > kOutlierResidual * noise_scale_) return 0.0f;
   const float difference = (residual_against - residual_for) / noise_scale_;
   return std::clamp(std::copysign(std::max(0.0f, std::abs(difference) - kDeadZone), difference), -kMaxRowVote,
                     kMaxRowVote);
@@ -220,6 +228,16 @@ const vision::EdgePoint *FloorBoundaryFinder::floor_contact(
     }
   }
   return contact;
+}
+
+bool FloorBoundaryFinder::vertical_beyond(int column, std::span<const vision::EdgePoint> edges,
+                                          std::size_t index) const {
+  for (std::size_t next = index + 1; next < edges.size(); ++next) {
+    if (contacts_[next] == nullptr) continue;
+    if (floor_or_vertical(column, edges[next].row_subpx, contacts_[next]->row_subpx) == Verdict::kVertical)
+      return true;
+  }
+  return false;
 }
 
 bool FloorBoundaryFinder::farther_base_explains_better(int column, float base_row, float base_contact_row,
@@ -295,6 +313,36 @@ const vision::EdgePoint *FloorBoundaryFinder::elevated_match(
   return match;
 }
 
+void FloorBoundaryFinder::measure_twin_spread(const vision::EdgeImage &inner_edges,
+                                              const vision::EdgeImage &outer_edges,
+                                              const vision::ColumnEdges &inner_candidates,
+                                              const vision::ColumnEdges &outer_candidates) {
+  // Every inner edge's nearest outer edge of the same polarity to where the floor puts it:
+  // on the floor (most edges near the robot are) the offset is the two edges' sub-pixel
+  // placement error; a robust spread of it (1.4826 MAD) measures that error for this frame.
+  ratios_.clear();
+  for (int column = 0; column < inner_candidates.columns(); column += 2) {
+    const auto outer_column = outer_candidates.column(column);
+    for (const vision::EdgePoint &edge : inner_candidates.column(column)) {
+      if (edge.row < rows_ / 2) continue;
+      const float floor_row = geometry_->floor_outer_row_at(edge.row_subpx);
+      if (!std::isfinite(floor_row)) continue;
+      const int sign = polarity(inner_edges, edge.row, column);
+      float nearest = std::numeric_limits<float>::infinity();
+      for (const vision::EdgePoint &outer : outer_column) {
+        const float offset = std::abs(outer.row_subpx - floor_row);
+        if (offset < nearest && polarity(outer_edges, outer.row, column) == sign) nearest = offset;
+      }
+      if (nearest <= kTwinSearchRows) ratios_.push_back(nearest);
+    }
+  }
+  const float median = median_of(ratios_);
+  twin_spread_px_ = std::isfinite(median) ? 1.4826f * median : 0.0f;
+  // Offsets the spread explains at the decision's error rate (a Gaussian's log-likelihood
+  // ratio z^2 / 2 reaching Wald's bound) do not by themselves put an edge above the floor.
+  ambiguous_offset_px_ = twin_spread_px_ * std::sqrt(2.0f * static_cast<float>(decision_llr_));
+}
+
 float FloorBoundaryFinder::floor_seen_outer_row(float farthest_floor_row) const {
   const float row = geometry_->floor_outer_row_at(farthest_floor_row);
   return std::isfinite(row) ? row : std::numeric_limits<float>::infinity();
@@ -311,6 +359,7 @@ BoundaryStats FloorBoundaryFinder::find(const FloorGeometry &geometry, const cv:
                                         std::vector<float> &free_range_m) {
   geometry_ = &geometry;
   prepare(inner_texture, outer_texture);
+  measure_twin_spread(inner_edges, outer_edges, inner_candidates, outer_candidates);
   BoundaryStats stats;
   stats.noise_scale = noise_scale_;
   const double floor_height_m = -geometry_->camera_height_m();
@@ -345,6 +394,14 @@ BoundaryStats FloorBoundaryFinder::find(const FloorGeometry &geometry, const cv:
           free_end_m = static_cast<float>(geometry_->floor_range_at(edge.row_subpx));
         continue;
       }
+      //    A twin less than the frame's placement error above the floor's row does not put
+      //    the edge above the floor by itself: the pixels beyond decide, as in step 3.
+      if (match != nullptr && std::abs(match->row_subpx - floor_row) <= ambiguous_offset_px_ &&
+          floor_or_vertical(column, edge.row_subpx, floor_row) == Verdict::kFloor) {
+        ++stats.floor_texture;
+        farthest_floor_row = edge.row_subpx;
+        continue;
+      }
       if (match != nullptr) {
         const auto stereo = triangulator.triangulate(column, edge.row_subpx, match->row_subpx);
         if (!stereo) continue;
@@ -356,7 +413,11 @@ BoundaryStats FloorBoundaryFinder::find(const FloorGeometry &geometry, const cv:
       // 3. On the floor: floor going on, or a vertical surface standing here?
       float outer_row = contact != nullptr ? contact->row_subpx : floor_row;
       const Verdict verdict = floor_or_vertical(column, edge.row_subpx, outer_row);
-      if (verdict == Verdict::kFloor) {
+      // An undecided edge (the rows beyond too uniform to tell) with a surface decisively
+      // standing on the floor farther out was floor texture: the floor reaches that surface.
+      const bool floor_reaches_farther = verdict == Verdict::kUndecided && contact != nullptr &&
+                                         vertical_beyond(column, inner_edges_here, index);
+      if (verdict == Verdict::kFloor || floor_reaches_farther) {
         ++stats.floor_texture;
         farthest_floor_row = edge.row_subpx;
         continue;

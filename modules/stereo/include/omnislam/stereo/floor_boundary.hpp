@@ -24,7 +24,11 @@
 ///  2. If it is not, the edge may be above the floor (a table top, a shelf): the outer edge
 ///     nearer than the floor that explains its window decisively better than the floor's
 ///     prediction and than every other candidate is triangulated and ends the search. With
-///     no such match the edge is unexplained (the free range stops there).
+///     no such match the edge is unexplained (the free range stops there). A match whose
+///     outer row lies within the frame's own placement error of the floor's row (the
+///     spread of floor edges' twins about it, measured per frame on the rows nearest the
+///     robot) does not by itself put the edge above the floor: if the pixels beyond are
+///     decisively floor (step 3's test), the edge is floor texture.
 ///  3. If it is, which hypothesis explains the pixels beyond it in both lobes: the floor
 ///     going on, or a vertical surface standing at the edge's range? Each row above the
 ///     edge compares the photometric residual of the two hypotheses (inner pixel against
@@ -32,7 +36,10 @@
 ///     sequential probability ratio test (Wald) accumulates them until one hypothesis wins
 ///     at the configured error rate. Floor wins: the edge is floor texture, and evidence of
 ///     free floor; the search goes on. The vertical surface wins, or the column ends
-///     undecided (a uniform wall explains both equally): the edge is where the floor ends.
+///     undecided (a uniform wall explains both equally): the edge is where the floor ends,
+///     unless (undecided) an edge farther out stands on the floor and is decisively a
+///     vertical surface: the floor reaches it. A row neither hypothesis explains (a dust
+///     speck, a highlight, a third surface in between) does not vote.
 ///     Its range is the floor range of the edge row (the floor plane is far more precise
 ///     than the stereo disparity: ~16 mm per row at 1-2 m against ~130 mm per pixel of
 ///     disparity, mirror.md sec. 9).
@@ -110,6 +117,15 @@ class FloorBoundaryFinder {
   /// The outer row from which on (downwards) the outer lobe shows floor already verified in
   /// this column: the floor row of the farthest floor-texture edge (+inf when there is none).
   [[nodiscard]] float floor_seen_outer_row(float farthest_floor_row) const;
+  /// The spread of the offset between floor edges' outer twins and the floor's row, and the
+  /// offset below which a twin does not decisively put an edge above the floor.
+  void measure_twin_spread(const vision::EdgeImage &inner_edges, const vision::EdgeImage &outer_edges,
+                           const vision::ColumnEdges &inner_candidates,
+                           const vision::ColumnEdges &outer_candidates);
+  /// Whether an edge of `edges` (one column's, nearest first) beyond `index` stands on the
+  /// floor (it has an outer twin there) and is decisively a vertical surface.
+  [[nodiscard]] bool vertical_beyond(int column, std::span<const vision::EdgePoint> edges,
+                                     std::size_t index) const;
   /// Whether floor up to the farther edge and a surface standing there explain the rows
   /// beyond the nearer base better than a surface standing at the nearer base.
   [[nodiscard]] bool farther_base_explains_better(int column, float base_row, float base_contact_row,
@@ -144,6 +160,8 @@ class FloorBoundaryFinder {
   std::vector<float> ratios_;
   std::vector<const vision::EdgePoint *> contacts_;  ///< per edge of the current column
   float noise_scale_ = 0.0f;
+  float twin_spread_px_ = 0.0f;
+  float ambiguous_offset_px_ = 0.0f;
 };
 
 }  // namespace omnislam::stereo
