@@ -218,6 +218,10 @@ TEST_CASE("config: the slam section, and the bundled thesis preset", "[io][confi
   CHECK(thesis.slam.use_srel_test);
   CHECK(thesis.slam.target == omnislam::slam::RegistrationTarget::kPreviousScan);
   CHECK_FALSE(thesis.slam.loop_closure.enabled);  // the thesis has no pose graph
+  CHECK_FALSE(thesis.slam.odometry_gate);         // nor a plausibility gate on corrections
+  CHECK(omnislam::io::Config{}.slam.odometry_gate);
+  CHECK_FALSE(omnislam::io::load_config(write_file("slam-gate.yaml", "slam:\n  odometry_gate: false\n"))
+                  .slam.odometry_gate);
 }
 
 TEST_CASE("config: slam.loop_closure, with unknown keys and bad values naming key and line", "[io][config]") {

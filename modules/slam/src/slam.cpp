@@ -27,8 +27,16 @@ bool Slam::accept(const TrimmedIcpResult &registration, const Eigen::Isometry2d 
   if (std::sqrt(registration.final_error_m2) > config_.max_rms_m) return false;
   if (registration.inlier_share < config_.min_inlier_share) return false;
   const Eigen::Isometry2d correction = predicted.inverse() * estimate;
-  return correction.translation().norm() <= config_.max_correction_m &&
-         std::abs(yaw_rad_of(correction)) <= config_.max_correction_rad;
+  if (correction.translation().norm() > config_.max_correction_m ||
+      std::abs(yaw_rad_of(correction)) > config_.max_correction_rad)
+    return false;
+  if (!config_.odometry_gate) return true;
+  constexpr double kChiSquare999ThreeDof = 16.27;
+  Eigen::Matrix3d S = prediction_covariance_;
+  S(0, 0) += registration.final_error_m2;
+  S(1, 1) += registration.final_error_m2;
+  const Eigen::Vector3d e(correction.translation().x(), correction.translation().y(), yaw_rad_of(correction));
+  return e.dot(S.ldlt().solve(e)) <= kChiSquare999ThreeDof;
 }
 
 bool Slam::accept_without_odometry(const TrimmedIcpResult &registration, const Eigen::Isometry2d &predicted,
@@ -122,6 +130,7 @@ void Slam::set_pose(const Eigen::Isometry2d &T_map_base, const Eigen::Matrix3d &
   anchor_T_map_base_ = T_map_base;
   previous_.T_map_base = T_map_base;
   previous_.covariance = covariance;
+  uncommitted_covariance_ = covariance;  // the operator's pose is as rough as they say
   last_step_ = Eigen::Isometry2d::Identity();
   // The scans before the jump sit at the old poses: the whole map stands in for them.
   if (!map_.empty()) recent_scans_map_.assign(1, map_.index().points());
@@ -210,6 +219,7 @@ FrameEstimate Slam::process(const Points2 &scan_base, const std::optional<Eigen:
     }
   }
   const Eigen::Isometry2d predicted = from * step;
+  prediction_covariance_ = uncommitted_covariance_ + odometry_step_covariance(step);
 
   FrameEstimate estimate;
   estimate.T_map_base = predicted;
@@ -226,6 +236,7 @@ FrameEstimate Slam::process(const Points2 &scan_base, const std::optional<Eigen:
   }
 
   bool in_graph = false;  // recorded as an integrated frame of the keyframe graph
+  uncommitted_covariance_ = estimate.integrated ? Eigen::Matrix3d::Zero() : prediction_covariance_;
   if (estimate.integrated) {
     relaxation_percent_ = 0.0;
     // A frame without odometry is registered but never changes the map: along a corridor

@@ -29,10 +29,10 @@
 /// slam:     {target: map | previous_scan, metric: point_to_line | point_to_point, overlap,
 ///            initial_search_radius_m, max_iterations, estimate_scale, keep_global_minimum,
 ///            use_srel_test, srel_limit_percent, srel_relax_percent, optional_map_correction,
-///            max_rms_m, min_inlier_share, max_correction_m, max_correction_deg, min_scan_points,
-///            use_odometry, no_odometry_min_srel_percent, no_odometry_max_rotation_deg, fusion_radius_m,
-///            noise_radius_m, noise_min_neighbors, prune_every, prune_min_hits, prune_min_age,
-///            localization_only}
+///            max_rms_m, min_inlier_share, max_correction_m, max_correction_deg, odometry_gate,
+///            min_scan_points, use_odometry, no_odometry_min_srel_percent, no_odometry_max_rotation_deg,
+///            fusion_radius_m, noise_radius_m, noise_min_neighbors, prune_every, prune_min_hits,
+///            prune_min_age, localization_only}
 /// degradation: {seed, center_px: [u, v],
 ///               exposure: {enabled, max_change}, vignetting: {enabled, rim_falloff, rim_radius_px},
 ///               dust: {enabled, count, min_radius_px, max_radius_px, min_opacity, max_opacity,

@@ -41,6 +41,12 @@ struct SlamConfig {
   /// A correction of the odometry prediction beyond these is implausible.
   double max_correction_m = 0.3;
   double max_correction_rad = 0.1745;
+  /// A correction the odometry noise model makes implausible is rejected: its Mahalanobis
+  /// distance under the motion's uncertainty since the last integrated frame (odometry
+  /// noise, plus the registration's own residual) beyond the chi-square bound of three
+  /// degrees of freedom at 99.9%. Along a plain corridor the scan fits anywhere, and a fit
+  /// that undoes a whole step of travel is the corridor, not the robot.
+  bool odometry_gate = true;
   int min_scan_points = 20;
   /// false: the thesis's SLAM without odometry (sec. 5.2): no motion prediction; the scan
   /// is registered against the map (with kMap) and the last three scans, forward then
@@ -160,6 +166,10 @@ class Slam {
   Eigen::Isometry2d last_step_ = Eigen::Isometry2d::Identity();  ///< previous_ relative to the frame before
   std::deque<Points2> recent_scans_map_;  ///< newest first: the last scans at their estimated poses
   double relaxation_percent_ = 0.0;
+  /// Uncertainty of the motion predicted for the current frame: the odometry steps since
+  /// the last integrated frame (or an operator's pose), in the odometry_gate.
+  Eigen::Matrix3d prediction_covariance_ = Eigen::Matrix3d::Zero();
+  Eigen::Matrix3d uncommitted_covariance_ = Eigen::Matrix3d::Zero();
   bool previous_failed_ = false;
 };
 
