@@ -220,6 +220,8 @@ TEST_CASE("config: the slam section, and the bundled thesis preset", "[io][confi
   CHECK_FALSE(thesis.slam.loop_closure.enabled);  // the thesis has no pose graph
   CHECK_FALSE(thesis.slam.odometry_gate);         // nor a plausibility gate on corrections
   CHECK(omnislam::io::Config{}.slam.odometry_gate);
+  CHECK_FALSE(thesis.slam.odometry_prior);  // nor a prior in the registration
+  CHECK(omnislam::io::Config{}.slam.odometry_prior);
   CHECK_FALSE(omnislam::io::load_config(write_file("slam-gate.yaml", "slam:\n  odometry_gate: false\n"))
                   .slam.odometry_gate);
 }

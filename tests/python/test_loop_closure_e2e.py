@@ -87,14 +87,16 @@ def test_two_laps_close_loops_and_the_thesis_preset_does_not(tmp_path):
 
 
 def test_building_two_laps_through_plain_corridors(tmp_path):
-    """building-2laps (96 m): along a plain corridor a scan fits anywhere, and without the
-    odometry gate a registration that undid a whole step of travel was taken (max 2.1 m).
-    Measured with the gate: max 376.9 mm, final 43.4 mm, map median 61.0 mm / 51.3%. The
-    issue asks final <= 100 mm (held) and max <= 250 mm (not yet: the trimmed fit still
-    pulls each corridor step back by a few centimetres, 0.57 m online over 12 m)."""
+    """building-2laps (96 m): along a plain corridor a scan fits anywhere. Without the
+    odometry gate a registration that undid a whole step of travel was taken (max 2.1 m);
+    with it but without the odometry prior the trimmed fit still pulled each step back by a
+    few centimetres (max 376.9 mm). Measured with both: max 148.7 mm, final 29.7 mm, online
+    max 196.9 mm, map median 29.5 mm / 63.6%. The issue asks final <= 100 mm, max <= 250 mm,
+    and the online final within 1.5x of the optimised one."""
     summary, evaluation = replay(tmp_path, "building-2laps", "on")
     ate = evaluation["ate"]
     assert ate["final_m"] <= 0.100
-    assert ate["max_m"] <= 0.45
-    assert evaluation["map"]["median_distance_m"] <= 0.1
+    assert ate["max_m"] <= 0.250
+    assert evaluation["online_ate"]["final_m"] <= 1.5 * ate["final_m"] + 0.005
+    assert evaluation["map"]["median_distance_m"] <= 0.05
     assert summary["loop_closures"] >= 10

@@ -88,3 +88,40 @@ TEST_CASE("trimmed ICP: degenerate inputs are reported invalid", "[slam][icp]") 
   result = register_trimmed_icp(NearestNeighbors(far), near, Eigen::Isometry2d::Identity());
   CHECK_FALSE(result.valid);
 }
+
+TEST_CASE("trimmed ICP: a position prior holds the pose along a plain corridor, the walls fix the rest",
+          "[slam][icp]") {
+  // Two walls 2 m apart along x, seen 3 m each way; the robot moved 0.3 m along the corridor,
+  // 5 cm sideways and turned 0.02 rad. Along x the walls say nothing (and trimming pulls the
+  // scan back over the mapped stretch); the odometry said 0.3 m.
+  std::mt19937_64 rng(3);
+  std::normal_distribution<double> noise(0.0, 0.005);
+  auto corridor = [&](const Eigen::Isometry2d &T_map_base) {
+    Points2 scan;
+    for (double x = -3.0; x <= 3.0; x += 0.05) {
+      for (const double y : {-1.0, 1.0}) {
+        const Eigen::Vector2d map_point(T_map_base.translation().x() + x, y);
+        scan.push_back(T_map_base.inverse() * map_point + Eigen::Vector2d(noise(rng), noise(rng)));
+      }
+    }
+    return scan;
+  };
+  const NearestNeighbors model(corridor(pose(0.0, 0.0, 0.0)));
+  const Eigen::Isometry2d truth = pose(0.3, 0.05, 0.02);
+  const Points2 sample = corridor(truth);
+  const Eigen::Isometry2d predicted = pose(0.3, 0.0, 0.0);
+  omnislam::slam::PosePrior prior;
+  prior.T_model_sample = predicted;
+  prior.translation_covariance = Eigen::Matrix2d::Identity() * 0.0144 * 0.0144;  // 10% of 0.25 m / sqrt 3
+  const auto held = register_trimmed_icp(model, sample, predicted, {}, &prior);
+  REQUIRE(held.valid);
+  const auto free = register_trimmed_icp(model, sample, predicted);
+  INFO("with the prior x " << held.T_model_sample.translation().x() << ", without "
+                           << free.T_model_sample.translation().x());
+  CHECK(std::abs(held.T_model_sample.translation().x() - 0.3) < 0.01);
+  CHECK(std::abs(held.T_model_sample.translation().y() - 0.05) < 0.005);
+  CHECK(std::abs(yaw_rad_of(held.T_model_sample) - 0.02) < 0.002);
+  CHECK(std::abs(free.T_model_sample.translation().x() - 0.3) > 0.05);  // slid along it without
+  // Across the corridor the walls, not the prior, decide: the prior said y = 0.
+  CHECK(std::abs(free.T_model_sample.translation().y() - 0.05) < 0.005);
+}

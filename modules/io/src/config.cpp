@@ -262,6 +262,7 @@ void read_slam(YamlSection &section, slam::SlamConfig &slam) {
   section.read("max_correction_m", slam.max_correction_m);
   read_degrees(section, "max_correction_deg", slam.max_correction_rad);
   section.read("odometry_gate", slam.odometry_gate);
+  section.read("odometry_prior", slam.odometry_prior);
   section.read("min_scan_points", slam.min_scan_points);
   section.read("use_odometry", slam.use_odometry);
   section.read("no_odometry_min_srel_percent", slam.no_odometry_min_srel_percent);

@@ -69,8 +69,10 @@ FrameEstimate Slam::register_scan(const Points2 &scan_base, const Eigen::Isometr
   FrameEstimate estimate;
   estimate.T_map_base = predicted;
 
+  const PosePrior prior{predicted, prediction_covariance_.topLeftCorner<2, 2>()};
+  const PosePrior *use_prior = config_.use_odometry && config_.odometry_prior ? &prior : nullptr;
   auto try_forward = [&](const NearestNeighbors &model, Attempt attempt) {
-    const TrimmedIcpResult r = register_trimmed_icp(model, scan_base, predicted, config_.icp);
+    const TrimmedIcpResult r = register_trimmed_icp(model, scan_base, predicted, config_.icp, use_prior);
     estimate.registration = r;
     if (!accepted(r, r.T_model_sample)) return false;
     estimate = {r.T_model_sample, true, attempt, r, r.covariance};

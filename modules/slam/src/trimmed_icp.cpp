@@ -10,6 +10,9 @@ namespace omnislam::slam {
 namespace {
 
 constexpr double kInlierDistanceM = 0.1;
+// The pairs' residual variance is floored (an exact fit must not give them infinite weight
+// against a prior): a millimetre, well below any range noise.
+constexpr double kMinResidualVarianceM2 = 1e-6;
 
 struct Pair {
   Point2 model;
@@ -104,9 +107,23 @@ NormalEquations normal_equations(const std::vector<Pair> &pairs, const Motion &m
   return eq;
 }
 
-Motion point_to_line_motion(const std::vector<Pair> &pairs, const Motion &current) {
+Motion point_to_line_motion(const std::vector<Pair> &pairs, const Motion &current, const PosePrior *prior,
+                            double residual_variance_m2) {
   const NormalEquations eq = normal_equations(pairs, current);
-  const Eigen::Vector3d delta = eq.JtJ.ldlt().solve(-eq.Jtr);
+  Eigen::Matrix3d A = eq.JtJ;
+  Eigen::Vector3d b = -eq.Jtr;
+  if (prior != nullptr) {
+    // The prior's residual, linearised in the left motion (dx, dy, dyaw) about the map
+    // origin: the sample origin t moves by (dx, dy) + dyaw * perp(t).
+    const Eigen::Vector2d t = current.T.translation();
+    Eigen::Matrix<double, 2, 3> H;
+    H << 1.0, 0.0, -t.y(), 0.0, 1.0, t.x();
+    const Eigen::Matrix2d W = prior->translation_covariance.inverse();
+    const Eigen::Vector2d e = t - prior->T_model_sample.translation();
+    A = A / residual_variance_m2 + H.transpose() * W * H;
+    b = b / residual_variance_m2 - H.transpose() * W * e;
+  }
+  const Eigen::Vector3d delta = A.ldlt().solve(b);
   if (!delta.allFinite()) return current;
   Eigen::Isometry2d step = Eigen::Isometry2d::Identity();
   step.linear() = Eigen::Rotation2Dd(delta.z()).toRotationMatrix();
@@ -130,8 +147,8 @@ Eigen::Matrix3d covariance_of(const std::vector<Pair> &pairs, const Motion &moti
 }  // namespace
 
 TrimmedIcpResult register_trimmed_icp(const NearestNeighbors &model, const Points2 &sample,
-                                      const Eigen::Isometry2d &initial_guess,
-                                      const TrimmedIcpConfig &config) {
+                                      const Eigen::Isometry2d &initial_guess, const TrimmedIcpConfig &config,
+                                      const PosePrior *prior) {
   TrimmedIcpResult result;
   result.T_model_sample = initial_guess;
   result.sample_points = sample.size();
@@ -169,8 +186,9 @@ TrimmedIcpResult register_trimmed_icp(const NearestNeighbors &model, const Point
     for (const Pair &pair : pairs)
       largest_sq = std::max(largest_sq, (current.apply(pair.sample) - pair.model).squaredNorm());
     search_radius = std::max(config.min_search_radius_m, std::sqrt(largest_sq));
-    current = config.metric == IcpMetric::kPointToLine ? point_to_line_motion(pairs, current)
-                                                       : horn_motion(pairs, config.estimate_scale);
+    current = config.metric == IcpMetric::kPointToLine
+                  ? point_to_line_motion(pairs, current, prior, std::max(error, kMinResidualVarianceM2))
+                  : horn_motion(pairs, config.estimate_scale);
   }
   if (best_pairs.empty()) return result;
 

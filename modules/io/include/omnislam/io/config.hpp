@@ -30,6 +30,7 @@
 ///            initial_search_radius_m, max_iterations, estimate_scale, keep_global_minimum,
 ///            use_srel_test, srel_limit_percent, srel_relax_percent, optional_map_correction,
 ///            max_rms_m, min_inlier_share, max_correction_m, max_correction_deg, odometry_gate,
+///            odometry_prior,
 ///            min_scan_points, use_odometry, no_odometry_min_srel_percent, no_odometry_max_rotation_deg,
 ///            fusion_radius_m, noise_radius_m, noise_min_neighbors, prune_every, prune_min_hits,
 ///            prune_min_age, localization_only}

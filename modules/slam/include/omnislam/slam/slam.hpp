@@ -47,6 +47,9 @@ struct SlamConfig {
   /// degrees of freedom at 99.9%. Along a plain corridor the scan fits anywhere, and a fit
   /// that undoes a whole step of travel is the corridor, not the robot.
   bool odometry_gate = true;
+  /// The same uncertainty as a prior of the registration (slam/trimmed_icp.hpp PosePrior):
+  /// where the scan does not constrain the pose, it stays at the odometry's prediction.
+  bool odometry_prior = true;
   int min_scan_points = 20;
   /// false: the thesis's SLAM without odometry (sec. 5.2): no motion prediction; the scan
   /// is registered against the map (with kMap) and the last three scans, forward then

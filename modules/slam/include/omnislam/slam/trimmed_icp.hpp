@@ -47,10 +47,21 @@ struct TrimmedIcpResult {
   Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();  ///< (x, y, yaw) of T_model_sample, from the residual
 };
 
+/// A Gaussian prior on the registered position (an odometry prediction): where the pairs do
+/// not constrain it (along a plain corridor) it holds the position; elsewhere the pairs,
+/// weighted by their residual variance, outweigh it. Position only: the heading is what
+/// scans constrain best (every wall gives it), the position along a corridor what they may
+/// not. Point-to-line only.
+struct PosePrior {
+  Eigen::Isometry2d T_model_sample = Eigen::Isometry2d::Identity();
+  Eigen::Matrix2d translation_covariance = Eigen::Matrix2d::Identity();  ///< of the sample frame's origin
+};
+
 /// Registers `sample` onto `model`, starting from `initial_guess`. Degenerate inputs
 /// (empty sets, fewer than 3 pairs) return valid = false with the initial guess.
 [[nodiscard]] TrimmedIcpResult register_trimmed_icp(const NearestNeighbors &model, const Points2 &sample,
                                                     const Eigen::Isometry2d &initial_guess,
-                                                    const TrimmedIcpConfig &config = {});
+                                                    const TrimmedIcpConfig &config = {},
+                                                    const PosePrior *prior = nullptr);
 
 }  // namespace omnislam::slam
