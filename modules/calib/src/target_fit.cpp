@@ -7,6 +7,7 @@
 #include <functional>
 #include <limits>
 #include <memory>
+#include <numbers>
 #include <utility>
 
 #include "finite_difference.hpp"
@@ -225,7 +226,10 @@ bool covariance_of(JointProblem &joint, TargetFitResult &result) {
   if (!covariance.Compute(blocks, joint.problem.get())) return false;
   Eigen::Matrix<double, kRigParameters, kRigParameters, Eigen::RowMajor> c;
   covariance.GetCovarianceBlock(joint.rig.data(), joint.rig.data(), c.data());
-  for (int i = 0; i < kRigParameters; ++i) result.sigma[i] = std::sqrt(c(i, i)) * kUnit[i];
+  for (int i = 0; i < kRigParameters; ++i) {
+    result.sigma[i] = std::sqrt(c(i, i)) * kUnit[i];
+    for (int j = 0; j < kRigParameters; ++j) result.covariance(i, j) = c(i, j) * kUnit[i] * kUnit[j];
+  }
   if (floor) {
     double variance = 0.0;
     covariance.GetCovarianceBlock(&joint.floor_z_m, &joint.floor_z_m, &variance);
@@ -248,9 +252,16 @@ void start_views(JointProblem &joint, const mirror::MirrorConfig &initial, const
       result.view_errors.push_back(error);
       continue;
     }
-    PlacedView placed{views[v].on_floor, true, *pose, views[v].corners};
+    const Eigen::Isometry3d T = detail::isometry_of(*pose);
+    const bool level =
+        std::abs(T.linear()(2, 2)) > std::cos(config.floor_level_deg * std::numbers::pi / 180.0);
+    const bool on_floor =
+        views[v].on_floor ||
+        (level && std::abs(T.translation().z() + config.floor_height_m) < config.floor_tolerance_m);
+    PlacedView placed{on_floor, true, *pose, views[v].corners};
+    result.used_views.push_back(static_cast<int>(v));
+    result.on_floor.push_back(on_floor);
     if (placed.on_floor) {
-      const Eigen::Isometry3d T = detail::isometry_of(*pose);
       placed.face_up = T.linear()(2, 2) > 0.0;
       placed.pose = {std::atan2(T.linear()(1, 0), T.linear()(0, 0)),
                      T.translation().x(),

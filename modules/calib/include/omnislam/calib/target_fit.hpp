@@ -83,6 +83,12 @@ struct TargetFitConfig {
   double outlier_px = 2.0;
   /// A view needs at least this many corners in the inner lobe (its pose starts from them).
   int min_corners = 6;
+  /// When set (the configured camera height, m), a view not flagged on_floor counts as on
+  /// the floor if its starting pose lies level (within `floor_level_deg`) and within
+  /// `floor_tolerance_m` of the floor: the user need not say which images those are.
+  double floor_height_m = std::numeric_limits<double>::quiet_NaN();
+  double floor_level_deg = 10.0;
+  double floor_tolerance_m = 0.15;
 };
 
 struct TargetFitResult {
@@ -101,6 +107,12 @@ struct TargetFitResult {
   double camera_height_sigma_m = std::numeric_limits<double>::quiet_NaN();
   std::array<double, kRigParameters> sigma{};     ///< as RigFitResult::sigma
   std::vector<Eigen::Isometry3d> T_camera_board;  ///< per used view (metres)
+  std::vector<int> used_views;                    ///< their indices into the views given
+  std::vector<bool> on_floor;                     ///< per used view: fitted as lying on the floor
+  /// Covariance of the parameters (RigParameter order, the units of `sigma`).
+  Eigen::Matrix<double, kRigParameters, kRigParameters> covariance =
+      Eigen::Matrix<double, kRigParameters, kRigParameters>::Constant(
+          std::numeric_limits<double>::quiet_NaN());
   std::string message;
 };
 
