@@ -238,12 +238,48 @@ bool covariance_of(JointProblem &joint, TargetFitResult &result) {
   return true;
 }
 
-// Every view's start; the views on the floor turned into their constrained form (yaw from
-// the board's x, the floor's height the median of theirs).
+// Turns the views marked by `lay` into boards on the floor, from their current poses: yaw
+// from the board's x, the floor's height (if not yet known) the median of theirs.
+void lay_on_floor(JointProblem &joint, const std::vector<bool> &lay) {
+  std::vector<double> heights;
+  for (std::size_t v = 0; v < joint.views.size(); ++v) {
+    PlacedView &view = joint.views[v];
+    if (!lay[v] || view.on_floor) continue;
+    const Eigen::Isometry3d T = detail::isometry_of(view.pose);
+    view.on_floor = true;
+    view.face_up = T.linear()(2, 2) > 0.0;
+    view.pose = {std::atan2(T.linear()(1, 0), T.linear()(0, 0)),
+                 T.translation().x(),
+                 T.translation().y(),
+                 0.0,
+                 0.0,
+                 0.0};
+    heights.push_back(T.translation().z());
+  }
+  if (!heights.empty() && std::isnan(joint.floor_z_m)) {
+    std::nth_element(heights.begin(), heights.begin() + heights.size() / 2, heights.end());
+    joint.floor_z_m = heights[heights.size() / 2];
+  }
+}
+
+// The held views whose fitted pose lies level and near the configured floor.
+std::vector<bool> found_on_floor(const JointProblem &joint, const TargetFitConfig &config) {
+  std::vector<bool> lay(joint.views.size(), false);
+  for (std::size_t v = 0; v < joint.views.size(); ++v) {
+    if (joint.views[v].on_floor) continue;
+    const Eigen::Isometry3d T = detail::isometry_of(joint.views[v].pose);
+    const bool level =
+        std::abs(T.linear()(2, 2)) > std::cos(config.floor_level_deg * std::numbers::pi / 180.0);
+    lay[v] = level && std::abs(T.translation().z() + config.floor_height_m) < config.floor_tolerance_m;
+  }
+  return lay;
+}
+
+// Every view's start (the views flagged on the floor in their constrained form).
 void start_views(JointProblem &joint, const mirror::MirrorConfig &initial, const TargetGeometry &target,
                  const std::vector<TargetView> &views, const TargetFitConfig &config,
                  TargetFitResult &result) {
-  std::vector<double> floor_heights;
+  std::vector<bool> lay;
   for (std::size_t v = 0; v < views.size(); ++v) {
     std::string error;
     const std::optional<Pose> pose = initial_pose(initial, target, views[v], config.min_corners, error);
@@ -252,32 +288,11 @@ void start_views(JointProblem &joint, const mirror::MirrorConfig &initial, const
       result.view_errors.push_back(error);
       continue;
     }
-    const Eigen::Isometry3d T = detail::isometry_of(*pose);
-    const bool level =
-        std::abs(T.linear()(2, 2)) > std::cos(config.floor_level_deg * std::numbers::pi / 180.0);
-    const bool on_floor =
-        views[v].on_floor ||
-        (level && std::abs(T.translation().z() + config.floor_height_m) < config.floor_tolerance_m);
-    PlacedView placed{on_floor, true, *pose, views[v].corners};
     result.used_views.push_back(static_cast<int>(v));
-    result.on_floor.push_back(on_floor);
-    if (placed.on_floor) {
-      placed.face_up = T.linear()(2, 2) > 0.0;
-      placed.pose = {std::atan2(T.linear()(1, 0), T.linear()(0, 0)),
-                     T.translation().x(),
-                     T.translation().y(),
-                     0.0,
-                     0.0,
-                     0.0};
-      floor_heights.push_back(T.translation().z());
-    }
-    joint.views.push_back(placed);
+    joint.views.push_back({false, true, *pose, views[v].corners});
+    lay.push_back(views[v].on_floor);
   }
-  if (!floor_heights.empty()) {
-    std::nth_element(floor_heights.begin(), floor_heights.begin() + floor_heights.size() / 2,
-                     floor_heights.end());
-    joint.floor_z_m = floor_heights[floor_heights.size() / 2];
-  }
+  lay_on_floor(joint, lay);
 }
 
 // Drops the corners farther than `outlier_px` from their projection; returns how many.
@@ -302,6 +317,7 @@ void fill_result(const JointProblem &joint, const mirror::MirrorConfig &initial,
   result.rim_rms_sigma = rim_residual_rms(joint);
   result.camera_height_m = -joint.floor_z_m;
   for (const PlacedView &view : joint.views) {
+    result.on_floor.push_back(view.on_floor);
     result.T_camera_board.push_back(
         view.on_floor ? detail::floor_isometry(view.pose.data(), joint.floor_z_m, view.face_up)
                       : detail::isometry_of(view.pose));
@@ -331,6 +347,16 @@ TargetFitResult fit_target(const mirror::MirrorConfig &initial, const TargetGeom
   }
   build(joint, initial, target, rim, config);
   solve(joint, config.max_iterations, result);
+  // The boards found lying on the floor (their first poses, from the configured rig, are
+  // too rough to tell) become boards on the floor.
+  if (!std::isnan(config.floor_height_m)) {
+    const std::vector<bool> lay = found_on_floor(joint, config);
+    if (std::find(lay.begin(), lay.end(), true) != lay.end()) {
+      lay_on_floor(joint, lay);
+      build(joint, initial, target, rim, config);
+      solve(joint, config.max_iterations, result);
+    }
+  }
   // Drop the corners that do not fit (a corner on the wrong square) and fit again.
   result.outliers = drop_outliers(joint, config.outlier_px);
   build(joint, initial, target, rim, config);
