@@ -107,12 +107,34 @@ Grid matched(const Grid &outer, const Grid &inner, int nx, int ny) {
   return best;
 }
 
-std::optional<Grid> find_grid(const Unrolled &lobe, const TargetGeometry &target) {
+std::optional<Grid> find_grid(const cv::Mat &panorama, const cv::Size &pattern, int flags) {
   Grid corners;
-  const cv::Size pattern(target.corners_x(), target.corners_y());
-  const int flags = cv::CALIB_CB_NORMALIZE_IMAGE | cv::CALIB_CB_ACCURACY;
-  if (!cv::findChessboardCornersSB(lobe.panorama, pattern, corners, flags)) return std::nullopt;
+  if (!cv::findChessboardCornersSB(panorama, pattern, corners, flags)) return std::nullopt;
   return corners;
+}
+
+// The board in a lobe's panorama: found first at half resolution (a quarter of the work),
+// then at full resolution in a window round it; where the coarse search fails (small
+// squares), over the whole panorama.
+std::optional<Grid> find_grid(const Unrolled &lobe, const TargetGeometry &target) {
+  const cv::Size pattern(target.corners_x(), target.corners_y());
+  const int fine = cv::CALIB_CB_NORMALIZE_IMAGE | cv::CALIB_CB_ACCURACY;
+  cv::Mat half;
+  cv::resize(lobe.panorama, half, cv::Size(), 0.5, 0.5, cv::INTER_AREA);
+  if (const std::optional<Grid> coarse = find_grid(half, pattern, cv::CALIB_CB_NORMALIZE_IMAGE)) {
+    const cv::Rect box = cv::boundingRect(*coarse);
+    // Two squares' margin round the corners' box (the board's outer squares and border).
+    const int margin = 2 * 2 * std::max(box.width / pattern.width, box.height / pattern.height) + 8;
+    const cv::Rect window = cv::Rect(2 * box.x - margin, 2 * box.y - margin, 2 * box.width + 2 * margin,
+                                     2 * box.height + 2 * margin) &
+                            cv::Rect(0, 0, lobe.panorama.cols, lobe.panorama.rows);
+    if (std::optional<Grid> grid = find_grid(lobe.panorama(window), pattern, fine)) {
+      for (cv::Point2f &p : *grid)
+        p += cv::Point2f(static_cast<float>(window.x), static_cast<float>(window.y));
+      return grid;
+    }
+  }
+  return find_grid(lobe.panorama, pattern, fine);
 }
 
 // The panorama's corners in the raw image.

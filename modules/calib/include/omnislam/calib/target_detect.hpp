@@ -9,13 +9,18 @@
 /// Finding a chessboard's inner corners in both lobes of one image (the target method).
 ///
 /// A chessboard detector wants a board that looks like a board: in the raw image each lobe
-/// shows it bent round the centre, smaller or larger by its radius. So each lobe is first
-/// unrolled into a panorama with the configured rig (rows: image radius, columns: azimuth,
-/// 420 degrees so a board across 0 degrees is whole once), where the board is upright and
-/// only mildly bent; cv::findChessboardCornersSB finds it there, the corners go back to the
-/// raw image through the same mapping (exact: the panorama is a pure resampling), and
-/// cv::cornerSubPix refines them in the raw image, where nothing was interpolated. Both
-/// lobes see a point at nearly the same azimuth and in the same vertical order, so the
+/// shows it bent round the centre, and the outer lobe squeezes it radially (a board on the
+/// floor has squares ~4 px tall there). So each lobe is first unrolled into a panorama with
+/// the configured rig (rows: image radius, 3 per pixel; columns: azimuth, 420 degrees so a
+/// board across 0 degrees is whole once), where the board is upright, only mildly bent and
+/// its squares large enough; cv::findChessboardCornersSB finds it there (first at half
+/// resolution, then at full resolution round what it found) with its sub-pixel refinement
+/// (CALIB_CB_ACCURACY), and the corners go back to the raw image through the same mapping
+/// (exact: the panorama is a pure resampling). Measured on renders
+/// (datasets/calib-target-rig, 24 images): 0.06-0.2 px rms per lobe against the truth.
+/// cv::cornerSubPix did worse: in the raw image 0.1-1.1 px on the outer lobe's small
+/// squares (its window reaches the next corners), in the panorama 0.36 px overall.
+/// Both lobes see a point at nearly the same azimuth and in the same vertical order, so the
 /// outer lobe's corners are numbered as the inner lobe's (the detector's start corner is
 /// arbitrary on a symmetric board).
 
