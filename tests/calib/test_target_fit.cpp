@@ -184,7 +184,7 @@ TEST_CASE("target fit: without boards on the floor the centre is weak, and the r
   CHECK(std::isnan(fit.camera_height_m));
 }
 
-TEST_CASE("target fit: too few views, a view without stereo corners, a wrong corner", "[calib][target]") {
+TEST_CASE("target fit: too few views, a view without inner-lobe corners, a wrong corner", "[calib][target]") {
   const MirrorConfig truth = true_rig();
   const TargetGeometry target;
   std::vector<TargetView> views = observe(truth, target, 4, 2, 0.05, 5);
