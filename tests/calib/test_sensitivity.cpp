@@ -1,6 +1,7 @@
 #include <catch2/catch.hpp>
 #include <cmath>
 
+#include "omnislam/calib/rig_fit.hpp"
 #include "omnislam/calib/sensitivity.hpp"
 #include "omnislam/mirror/mirror_model.hpp"
 #include "omnislam/stereo/floor_geometry.hpp"
@@ -30,4 +31,25 @@ TEST_CASE("range sensitivity: a centre pixel costs one row of floor range", "[ca
   // scales both radii and so the disparity, a centre error shifts both alike.
   CHECK(rows[1].floor_plane_m[2] < rows[1].stereo_m[2]);
   CHECK(rows[0].stereo_m[2] < rows[0].floor_plane_m[2]);
+}
+
+TEST_CASE(
+    "range uncertainty: a focal sigma of 0.1% costs what the sensitivity table says, a centre sigma "
+    "1/sqrt(2) of its worst azimuth",
+    "[calib][sensitivity]") {
+  const omnislam::mirror::MirrorConfig camera;
+  const auto rows = omnislam::calib::range_sensitivity(camera, 1.0);
+  Eigen::Matrix<double, 8, 8> covariance = Eigen::Matrix<double, 8, 8>::Zero();
+  covariance(omnislam::calib::kFocalScale, omnislam::calib::kFocalScale) = 1e-6;  // sigma 0.1%
+  const auto focal = omnislam::calib::range_uncertainty(camera, covariance, 1.0);
+  covariance.setZero();
+  covariance(omnislam::calib::kCenterU, omnislam::calib::kCenterU) = 1.0;  // sigma 1 px
+  const auto centre = omnislam::calib::range_uncertainty(camera, covariance, 1.0);
+  for (std::size_t i = 0; i < 3; ++i) {
+    CAPTURE(i, focal.floor_plane_m[i], focal.stereo_m[i], centre.floor_plane_m[i], centre.stereo_m[i]);
+    CHECK(focal.floor_plane_m[i] == Approx(rows[1].floor_plane_m[i]).epsilon(0.1));
+    CHECK(focal.stereo_m[i] == Approx(rows[1].stereo_m[i]).epsilon(0.1));
+    CHECK(centre.floor_plane_m[i] == Approx(rows[0].floor_plane_m[i] / std::sqrt(2.0)).epsilon(0.15));
+    CHECK(centre.stereo_m[i] == Approx(rows[0].stereo_m[i] / std::sqrt(2.0)).epsilon(0.15));
+  }
 }

@@ -5,37 +5,14 @@
 #include <cmath>
 #include <limits>
 
+#include "rig_parameters.hpp"
+
 namespace omnislam::calib {
 namespace {
 
-// Parameters in units of similar effect (about a pixel each): px, px, 1e-3 of focal length,
-// mm, mrad, mrad, mm, mm. Near-equal scales keep the trust region round.
-constexpr std::array<double, kRigParameters> kUnit{1.0, 1.0, 1e-3, 1.0, 1e-3, 1e-3, 1.0, 1.0};
-
-mirror::MirrorConfig apply(mirror::MirrorConfig config, const double *p) {
-  config.center_u_px = p[kCenterU] * kUnit[kCenterU];
-  config.center_v_px = p[kCenterV] * kUnit[kCenterV];
-  config.rig.focal_scale = p[kFocalScale] * kUnit[kFocalScale];
-  config.rig.mirror_dz_mm = p[kMirrorDz] * kUnit[kMirrorDz];
-  config.rig.mirror_tilt_x_rad = p[kTiltX] * kUnit[kTiltX];
-  config.rig.mirror_tilt_y_rad = p[kTiltY] * kUnit[kTiltY];
-  config.rig.mirror_offset_x_mm = p[kOffsetX] * kUnit[kOffsetX];
-  config.rig.mirror_offset_y_mm = p[kOffsetY] * kUnit[kOffsetY];
-  return config;
-}
-
-std::array<double, kRigParameters> parameters_of(const mirror::MirrorConfig &config) {
-  std::array<double, kRigParameters> p{config.center_u_px,
-                                       config.center_v_px,
-                                       config.rig.focal_scale,
-                                       config.rig.mirror_dz_mm,
-                                       config.rig.mirror_tilt_x_rad,
-                                       config.rig.mirror_tilt_y_rad,
-                                       config.rig.mirror_offset_x_mm,
-                                       config.rig.mirror_offset_y_mm};
-  for (int i = 0; i < kRigParameters; ++i) p[i] /= kUnit[i];
-  return p;
-}
+using detail::apply;
+using detail::kUnit;
+using detail::parameters_of;
 
 // Reprojection error of one observation. The model is traced (RigModel::project iterates),
 // so the derivatives are numerical.

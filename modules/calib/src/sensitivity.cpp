@@ -5,7 +5,11 @@
 #include <limits>
 #include <optional>
 
+#include <numbers>
+
+#include "omnislam/calib/rig_fit.hpp"
 #include "omnislam/mirror/mirror_model.hpp"
+#include "omnislam/mirror/rig_model.hpp"
 #include "omnislam/stereo/floor_geometry.hpp"
 
 namespace omnislam::calib {
@@ -44,7 +48,76 @@ Radii project(const mirror::MirrorModel &model, const mirror::MeridianPoint &poi
           model.project_radius_px(mirror::Lobe::kOuter, point).value_or(kNaN)};
 }
 
+constexpr int kAzimuths = 8;
+// Steps of the derivatives: a tenth of each parameter's unit of about a pixel's effect.
+constexpr std::array<double, kRigParameters> kRangeSteps{0.1, 0.1, 1e-4, 0.1, 1e-4, 1e-4, 0.1, 0.1};
+
+// Horizontal ranges read back with `read` from the pixels at which `truth` images `point`.
+struct ReadBack {
+  double floor_plane_m = kNaN;
+  double stereo_m = kNaN;
+};
+ReadBack read_back(const mirror::RigModel &truth, const mirror::RigModel &read,
+                   const Eigen::Vector3d &point) {
+  using mirror::Lobe;
+  ReadBack out;
+  const auto inner_px = truth.project(Lobe::kInner, point);
+  const auto outer_px = truth.project(Lobe::kOuter, point);
+  if (!inner_px || !outer_px) return out;
+  const auto inner = read.back_project(Lobe::kInner, *inner_px);
+  const auto outer = read.back_project(Lobe::kOuter, *outer_px);
+  if (!inner || !outer) return out;
+  if (inner->direction.z() < 0.0) {
+    const double t = (point.z() - inner->origin_m.z()) / inner->direction.z();
+    out.floor_plane_m = (inner->origin_m + t * inner->direction).head<2>().norm();
+  }
+  if (const auto met = mirror::RigModel::intersect(*inner, *outer))
+    out.stereo_m = met->point_m.head<2>().norm();
+  return out;
+}
+
+mirror::MirrorConfig stepped(mirror::MirrorConfig config, int parameter, double step) {
+  double *values[kRigParameters] = {&config.center_u_px,
+                                    &config.center_v_px,
+                                    &config.rig.focal_scale,
+                                    &config.rig.mirror_dz_mm,
+                                    &config.rig.mirror_tilt_x_rad,
+                                    &config.rig.mirror_tilt_y_rad,
+                                    &config.rig.mirror_offset_x_mm,
+                                    &config.rig.mirror_offset_y_mm};
+  *values[parameter] += step;
+  return config;
+}
+
 }  // namespace
+
+RangeUncertainty range_uncertainty(const mirror::MirrorConfig &camera,
+                                   const Eigen::Matrix<double, 8, 8> &covariance, double camera_height_m) {
+  const mirror::RigModel read(camera);
+  std::vector<mirror::RigModel> perturbed;
+  for (int i = 0; i < kRigParameters; ++i) perturbed.emplace_back(stepped(camera, i, kRangeSteps[i]));
+  RangeUncertainty out;
+  for (std::size_t r = 0; r < kSensitivityRangesM.size(); ++r) {
+    double floor_sum = 0.0, stereo_sum = 0.0;
+    for (int a = 0; a < kAzimuths; ++a) {
+      const double phi = 2.0 * std::numbers::pi * (a + 0.5) / kAzimuths;
+      const Eigen::Vector3d point(kSensitivityRangesM[r] * std::cos(phi),
+                                  kSensitivityRangesM[r] * std::sin(phi), -camera_height_m);
+      const ReadBack base = read_back(read, read, point);
+      Eigen::Matrix<double, 1, kRigParameters> d_floor, d_stereo;
+      for (int i = 0; i < kRigParameters; ++i) {
+        const ReadBack moved = read_back(perturbed[static_cast<std::size_t>(i)], read, point);
+        d_floor(i) = (moved.floor_plane_m - base.floor_plane_m) / kRangeSteps[i];
+        d_stereo(i) = (moved.stereo_m - base.stereo_m) / kRangeSteps[i];
+      }
+      floor_sum += (d_floor * covariance * d_floor.transpose())(0, 0);
+      stereo_sum += (d_stereo * covariance * d_stereo.transpose())(0, 0);
+    }
+    out.floor_plane_m[r] = std::sqrt(floor_sum / kAzimuths);
+    out.stereo_m[r] = std::sqrt(stereo_sum / kAzimuths);
+  }
+  return out;
+}
 
 std::vector<RangeSensitivity> range_sensitivity(const mirror::MirrorConfig &camera, double camera_height_m) {
   const mirror::MirrorModel model(camera);

@@ -1,5 +1,6 @@
 #pragma once
 
+#include <Eigen/Core>
 #include <array>
 #include <string>
 #include <vector>
@@ -27,5 +28,19 @@ struct RangeSensitivity {
 /// length), for a camera `camera_height_m` above the floor.
 [[nodiscard]] std::vector<RangeSensitivity> range_sensitivity(const mirror::MirrorConfig &camera,
                                                               double camera_height_m);
+
+/// The range error (1 sigma) that an uncertain rig implies for a wall's base on the floor
+/// at kSensitivityRangesM: `camera` is the rig as fitted, `covariance` its parameters'
+/// (RigParameter order and units: px, px, 1, mm, rad, rad, mm, mm). The derivative of the
+/// range read back with `camera` from where a rig off by each parameter images the point
+/// (general rig model) is propagated through the covariance, so correlated errors that
+/// cancel in the image cancel here too; RMS over eight azimuths.
+struct RangeUncertainty {
+  std::array<double, 3> floor_plane_m{};  ///< the inner lobe's ray met with the floor
+  std::array<double, 3> stereo_m{};       ///< the two lobes' rays triangulated
+};
+[[nodiscard]] RangeUncertainty range_uncertainty(const mirror::MirrorConfig &camera,
+                                                 const Eigen::Matrix<double, 8, 8> &covariance,
+                                                 double camera_height_m);
 
 }  // namespace omnislam::calib
