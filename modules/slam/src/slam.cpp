@@ -30,7 +30,7 @@ bool Slam::accept(const TrimmedIcpResult &registration, const Eigen::Isometry2d 
   if (correction.translation().norm() > config_.max_correction_m ||
       std::abs(yaw_rad_of(correction)) > config_.max_correction_rad)
     return false;
-  if (!config_.odometry_gate) return true;
+  if (!config_.odometry_gate || !predicted_by_odometry_) return true;
   constexpr double kChiSquare999ThreeDof = 16.27;
   Eigen::Matrix3d S = prediction_covariance_;
   S(0, 0) += registration.final_error_m2;
@@ -70,7 +70,7 @@ FrameEstimate Slam::register_scan(const Points2 &scan_base, const Eigen::Isometr
   estimate.T_map_base = predicted;
 
   const PosePrior prior{predicted, prediction_covariance_.topLeftCorner<2, 2>()};
-  const PosePrior *use_prior = config_.use_odometry && config_.odometry_prior ? &prior : nullptr;
+  const PosePrior *use_prior = predicted_by_odometry_ && config_.odometry_prior ? &prior : nullptr;
   auto try_forward = [&](const NearestNeighbors &model, Attempt attempt) {
     const TrimmedIcpResult r = register_trimmed_icp(model, scan_base, predicted, config_.icp, use_prior);
     estimate.registration = r;
@@ -222,6 +222,9 @@ FrameEstimate Slam::process(const Points2 &scan_base, const std::optional<Eigen:
   }
   const Eigen::Isometry2d predicted = from * step;
   prediction_covariance_ = uncommitted_covariance_ + odometry_step_covariance(step);
+  // In an odometry gap the motion is a guess (the last one kept up): neither a prior nor a
+  // reason to reject a correction.
+  predicted_by_odometry_ = config_.use_odometry && T_odom_base.has_value();
 
   FrameEstimate estimate;
   estimate.T_map_base = predicted;

@@ -173,6 +173,7 @@ class Slam {
   /// the last integrated frame (or an operator's pose), in the odometry_gate.
   Eigen::Matrix3d prediction_covariance_ = Eigen::Matrix3d::Zero();
   Eigen::Matrix3d uncommitted_covariance_ = Eigen::Matrix3d::Zero();
+  bool predicted_by_odometry_ = false;  ///< the current frame's prediction came from odometry
   bool previous_failed_ = false;
 };
 
