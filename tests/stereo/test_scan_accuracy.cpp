@@ -68,7 +68,7 @@ TEST_CASE("sim-room-37: local scans against the floor plan", "[stereo][accuracy]
 }
 
 // Tiled floor, soft shadows, sunlight; then every sensor factor on top. Measured: noise-free
-// 0.18% / 97.2% within 0.1 m / coverage 89.7%; degraded 0.23% / 96.7% / 84.8% (the issue:
+// 0.18% / 97.4% within 0.1 m / coverage 89.7%; degraded 0.23% / 96.6% / 83.6% (the issue:
 // median <= 2%, >= 90% within 0.1 m).
 TEST_CASE("sim-room-37-real: local scans against the floor plan", "[stereo][accuracy][dataset]") {
   const omnislam::test::ScanAccuracy clean = scan_accuracy("sim-room-37-real", 37, false);
@@ -86,11 +86,10 @@ TEST_CASE("sim-room-37-real: local scans against the floor plan", "[stereo][accu
 }
 
 // The office: hexagon carpet, a pillar, furniture, camera 0.8 m up, robot facing its travel.
-// Measured: noise-free 0.29% / 91.1% within 0.1 m / coverage 87.0%; degraded 0.33% /
-// 89.96% / 81.0% (86.1% / 82.1% before rows unexplained by both hypotheses stopped voting
-// and twins within the frame's placement error stopped making low obstacles by themselves;
-// coverage counts degrees with any point, so dropping wrong points lowers it). The issue
-// asks >= 90% within 0.1 m: not yet held degraded, by 0.04 points. What remains: floor
+// Measured: noise-free 0.29% / 91.2% within 0.1 m / coverage 87.0%; degraded 0.32% / 90.5%
+// / 80.8% (86.1% / 82.1% before rows unexplained by both hypotheses stopped voting and twins
+// within the frame's placement error stopped making low obstacles by themselves; coverage
+// counts degrees with any point, so dropping wrong points lowers it). What remains: floor
 // texture at 3-5 m where too few rows lie between it and the wall for the test to decide,
 // carpet edges whose twin is more than the placement error off, and missed table tops.
 TEST_CASE("office-real: local scans against the floor plan", "[stereo][accuracy][dataset]") {
@@ -100,14 +99,14 @@ TEST_CASE("office-real: local scans against the floor plan", "[stereo][accuracy]
   CHECK(clean.coverage() >= 0.85);
   const omnislam::test::ScanAccuracy degraded = scan_accuracy("office-real", 45, true);
   CHECK(degraded.median_relative_error() <= 0.02);
-  CHECK(degraded.near_segment_share() >= 0.89);
-  CHECK(degraded.coverage() >= 0.80);
+  CHECK(degraded.near_segment_share() >= 0.90);
+  CHECK(degraded.coverage() >= 0.79);
   CHECK(degraded.free_known_share() >= 0.90);
   CHECK(degraded.free_overclaim_share() <= 0.15);
 }
 
 // The L-room with oak planks, a rug, pendant lamps over the tables and sunlight. Measured:
-// degraded 0.64% / 93.9% within 0.1 m / coverage 81.1% (93.3% / 81.6% before the changes
+// degraded 0.64% / 94.0% within 0.1 m / coverage 81.1% (93.3% / 81.6% before the changes
 // noted at the office).
 TEST_CASE("l-room-1lap-real: local scans against the floor plan", "[stereo][accuracy][dataset]") {
   const omnislam::test::ScanAccuracy degraded = scan_accuracy("l-room-1lap-real", 60, true);

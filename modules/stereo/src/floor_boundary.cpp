@@ -336,11 +336,15 @@ void FloorBoundaryFinder::measure_twin_spread(const vision::EdgeImage &inner_edg
       if (nearest <= kTwinSearchRows) ratios_.push_back(nearest);
     }
   }
+  // The offsets are Laplace-distributed (measured on the degraded office: 86% within 0.5 px,
+  // 10% within 0.5-1 px, 2-3% beyond, as a Laplace of scale 0.25 px gives and a Gaussian
+  // does not), like the photometric residuals: the scale is the median over ln 2.
   const float median = median_of(ratios_);
-  twin_spread_px_ = std::isfinite(median) ? 1.4826f * median : 0.0f;
-  // Offsets the spread explains at the decision's error rate (a Gaussian's log-likelihood
-  // ratio z^2 / 2 reaching Wald's bound) do not by themselves put an edge above the floor.
-  ambiguous_offset_px_ = twin_spread_px_ * std::sqrt(2.0f * static_cast<float>(decision_llr_));
+  twin_spread_px_ = std::isfinite(median) ? median / std::numbers::ln2_v<float> : 0.0f;
+  // Offsets the spread explains at the decision's error rate (the Laplace log-likelihood
+  // ratio |offset| / scale reaching Wald's bound) do not by themselves put an edge above the
+  // floor.
+  ambiguous_offset_px_ = twin_spread_px_ * static_cast<float>(decision_llr_);
 }
 
 float FloorBoundaryFinder::floor_seen_outer_row(float farthest_floor_row) const {
