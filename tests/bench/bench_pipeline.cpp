@@ -1,9 +1,15 @@
 // Pipeline benchmark (not a test): throughput replaying as fast as possible from memory
 // (images decoded beforehand, the dataset looped), then capture->pose latency with live
-// input at 30 Hz. Run it through scripts/bench-pipeline (2 cores).
+// input at 30 Hz. Both runs also print the per-frame SLAM stage p99 of the first and the
+// last loop of the dataset (issue 13: the 20th loop within 20% of the first). Run it
+// through scripts/bench-pipeline (2 cores).
 //
 //   bench_pipeline [DATASET] [--loops N] [--live-seconds S] [--rate HZ] [--no-loop-closure]
+//                  [--loop-closure inline|background]
+// --loop-closure sets where loop closure runs in both runs; by default the pipeline's
+// choice by mode: inline in the throughput (replay) run, background in the live run.
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
@@ -54,6 +60,30 @@ pipeline::FrameSource looped(const Data &data, std::size_t frames) {
   };
 }
 
+double p99(std::vector<double> values) {
+  if (values.empty()) return 0.0;
+  std::sort(values.begin(), values.end());
+  return values[static_cast<std::size_t>(0.99 * static_cast<double>(values.size() - 1))];
+}
+
+// The SLAM stage's time of every frame that got through, by loop of the dataset.
+struct PerLoop {
+  std::size_t frames_per_loop = 1;
+  std::vector<std::vector<double>> slam_ms;
+
+  void add(const pipeline::Frame &frame) {
+    const std::size_t loop = static_cast<std::size_t>(frame.sequence - 1) / frames_per_loop;
+    if (slam_ms.size() <= loop) slam_ms.resize(loop + 1);
+    slam_ms[loop].push_back(frame.timings.stage_ms[pipeline::kSlam]);
+  }
+  void print() const {
+    if (slam_ms.size() < 2) return;
+    const double first = p99(slam_ms.front()), last = p99(slam_ms.back());
+    std::printf("  per-frame SLAM p99: loop 1 %.2f ms, loop %zu %.2f ms (ratio %.2f)\n", first,
+                slam_ms.size(), last, first > 0.0 ? last / first : 0.0);
+  }
+};
+
 }  // namespace
 
 int main(int argc, char **argv) {
@@ -61,6 +91,7 @@ int main(int argc, char **argv) {
   int loops = 20;
   double live_seconds = 10.0, rate_hz = 30.0;
   slam::SlamConfig slam_config;  // the defaults: loop closure on
+  pipeline::LoopClosureThread loop_closure = pipeline::LoopClosureThread::kByMode;
   for (int i = 1; i < argc; ++i) {
     const std::string arg = argv[i];
     if (arg == "--loops" && i + 1 < argc) {
@@ -71,6 +102,10 @@ int main(int argc, char **argv) {
       rate_hz = std::atof(argv[++i]);
     } else if (arg == "--no-loop-closure") {
       slam_config.loop_closure.enabled = false;
+    } else if (arg == "--loop-closure" && i + 1 < argc) {
+      const std::string where = argv[++i];
+      loop_closure =
+          where == "inline" ? pipeline::LoopClosureThread::kInline : pipeline::LoopClosureThread::kBackground;
     } else {
       dataset = arg;
     }
@@ -79,21 +114,33 @@ int main(int argc, char **argv) {
 
   {  // 1. Throughput: replay mode (blocking queues), input as fast as memory gives it.
     const std::size_t frames = data.images.size() * static_cast<std::size_t>(loops);
-    pipeline::Pipeline pipeline(data.scan, slam_config, {}, {});
+    pipeline::PipelineConfig config;
+    config.loop_closure = loop_closure;
+    PerLoop per_loop{data.images.size(), {}};
+    pipeline::Sinks sinks;
+    sinks.frame = [&](const pipeline::Frame &frame) { per_loop.add(frame); };
+    pipeline::Pipeline pipeline(data.scan, slam_config, config, sinks);
     const auto start = std::chrono::steady_clock::now();
     pipeline.run(looped(data, frames));
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     std::printf("throughput: %zu frames in %.3f s = %.1f frames/s (as fast as possible, from memory)\n",
                 frames, seconds, static_cast<double>(frames) / seconds);
+    std::printf("  loop closures %d, keyframes %zu, background loop jobs %llu\n",
+                pipeline.slam().loop_closures(), pipeline.slam().keyframes().keyframes().size(),
+                static_cast<unsigned long long>(pipeline.loop_jobs_done()));
+    per_loop.print();
   }
   {  // 2. Latency: live mode at a camera's rate.
     pipeline::PipelineConfig config;
     config.mode = pipeline::Mode::kLive;
     config.input_rate_hz = rate_hz;
     config.profile_window = 1 << 20;
+    config.loop_closure = loop_closure;
     pipeline::ProfileSnapshot profile;
+    PerLoop per_loop{data.images.size(), {}};
     pipeline::Sinks sinks;
     sinks.profile = [&](const pipeline::ProfileSnapshot &p) { profile = p; };
+    sinks.frame = [&](const pipeline::Frame &frame) { per_loop.add(frame); };
     const auto frames = static_cast<std::size_t>(live_seconds * rate_hz);
     pipeline::Pipeline pipeline(data.scan, slam_config, config, sinks);
     pipeline.run(looped(data, frames));
@@ -105,7 +152,10 @@ int main(int argc, char **argv) {
     for (std::size_t s = 0; s < pipeline::kStages.size(); ++s) {
       std::printf(" %s %.2f", std::string(pipeline::kStages[s]).c_str(), profile.stages[s].mean_ms);
     }
-    std::printf("\n");
+    std::printf("\n  loop closures %d, keyframes %zu, background loop jobs %llu\n",
+                pipeline.slam().loop_closures(), pipeline.slam().keyframes().keyframes().size(),
+                static_cast<unsigned long long>(pipeline.loop_jobs_done()));
+    per_loop.print();
   }
   return 0;
 }

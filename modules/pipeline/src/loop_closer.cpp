@@ -1,10 +1,13 @@
 #include "omnislam/pipeline/loop_closer.hpp"
 
+#include <sys/resource.h>
+#include <unistd.h>
+
 #include <utility>
 
 namespace omnislam::pipeline {
 
-LoopCloser::LoopCloser() : thread_([this] { run(); }) {}
+LoopCloser::LoopCloser(int nice) : thread_([this, nice] { run(nice); }) {}
 
 LoopCloser::~LoopCloser() {
   {
@@ -45,7 +48,10 @@ std::uint64_t LoopCloser::jobs_done() const {
   return done_;
 }
 
-void LoopCloser::run() {
+void LoopCloser::run(int nice) {
+  // Linux gives each thread its own nice value. Failing to lower the priority only costs
+  // latency, so the result is not checked.
+  if (nice > 0) (void)setpriority(PRIO_PROCESS, static_cast<id_t>(gettid()), nice);
   for (;;) {
     std::optional<slam::LoopJob> job;
     {

@@ -102,7 +102,7 @@ void Pipeline::start(FrameSource source) {
   // remap give the same pixels either way.
   cv::setNumThreads(0);
   if (with_loop_closure_thread({}, config_).loop_closure.background)
-    loop_closer_ = std::make_unique<LoopCloser>();
+    loop_closer_ = std::make_unique<LoopCloser>(config_.loop_closure_nice);
   threads_[0] =
       std::thread([this, source = std::move(source)]() mutable { capture_loop(std::move(source)); });
   threads_[1] = std::thread([this] { frontend_loop(); });

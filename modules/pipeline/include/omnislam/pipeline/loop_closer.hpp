@@ -23,8 +23,9 @@ namespace omnislam::pipeline {
 /// destructor from that thread or after it ended.
 class LoopCloser {
  public:
-  /// Starts the worker thread.
-  LoopCloser();
+  /// Starts the worker thread at `nice` (Linux: a thread's own nice value, 0..19; higher
+  /// yields more): the per-frame stages then keep the cores they share with it.
+  explicit LoopCloser(int nice = 0);
   LoopCloser(const LoopCloser &) = delete;
   LoopCloser &operator=(const LoopCloser &) = delete;
   /// Lets the job in progress finish, drops jobs not started and results not taken, joins.
@@ -41,7 +42,7 @@ class LoopCloser {
   [[nodiscard]] std::uint64_t jobs_done() const;
 
  private:
-  void run();
+  void run(int nice);
 
   mutable std::mutex mutex_;
   std::condition_variable job_ready_;     ///< the worker waits for a job or stop

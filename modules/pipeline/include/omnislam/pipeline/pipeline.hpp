@@ -40,6 +40,10 @@ enum class LoopClosureThread {
 struct PipelineConfig {
   Mode mode = Mode::kReplay;
   LoopClosureThread loop_closure = LoopClosureThread::kByMode;
+  /// Nice value of the background loop-closure thread (0..19): at 19 a stage thread that
+  /// wants the core it shares gets ~98% of it, so a search or map rebuild of a few hundred
+  /// ms does not stretch the frames' latency; the worker uses what the stages leave idle.
+  int loop_closure_nice = 19;
   std::size_t queue_capacity = 4;      ///< frames per queue (each holds an image: memory is bounded)
   double input_rate_hz = 0.0;          ///< capture paces the source to this rate; 0 = as fast as it delivers
   bool map_every_integration = false;  ///< attach the map to every integrated frame (thesis mapaN.txt)
