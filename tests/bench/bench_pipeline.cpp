@@ -76,11 +76,13 @@ struct PerLoop {
     if (slam_ms.size() <= loop) slam_ms.resize(loop + 1);
     slam_ms[loop].push_back(frame.timings.stage_ms[pipeline::kSlam]);
   }
-  void print() const {
-    if (slam_ms.size() < 2) return;
-    const double first = p99(slam_ms.front()), last = p99(slam_ms.back());
-    std::printf("  per-frame SLAM p99: loop 1 %.2f ms, loop %zu %.2f ms (ratio %.2f)\n", first,
-                slam_ms.size(), last, first > 0.0 ? last / first : 0.0);
+  /// The first and the last complete loop of `frames` captured.
+  void print(std::size_t frames) const {
+    const std::size_t loops = std::min(frames / frames_per_loop, slam_ms.size());
+    if (loops < 2) return;
+    const double first = p99(slam_ms.front()), last = p99(slam_ms[loops - 1]);
+    std::printf("  per-frame SLAM p99: loop 1 %.2f ms, loop %zu %.2f ms (ratio %.2f)\n", first, loops, last,
+                first > 0.0 ? last / first : 0.0);
   }
 };
 
@@ -128,7 +130,7 @@ int main(int argc, char **argv) {
     std::printf("  loop closures %d, keyframes %zu, background loop jobs %llu\n",
                 pipeline.slam().loop_closures(), pipeline.slam().keyframes().keyframes().size(),
                 static_cast<unsigned long long>(pipeline.loop_jobs_done()));
-    per_loop.print();
+    per_loop.print(frames);
   }
   {  // 2. Latency: live mode at a camera's rate.
     pipeline::PipelineConfig config;
@@ -155,7 +157,7 @@ int main(int argc, char **argv) {
     std::printf("\n  loop closures %d, keyframes %zu, background loop jobs %llu\n",
                 pipeline.slam().loop_closures(), pipeline.slam().keyframes().keyframes().size(),
                 static_cast<unsigned long long>(pipeline.loop_jobs_done()));
-    per_loop.print();
+    per_loop.print(frames);
   }
   return 0;
 }

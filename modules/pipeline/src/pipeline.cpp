@@ -340,8 +340,11 @@ void Pipeline::slam_loop() {
     busy(3, false);
     forward(queues_[kPublish], frame);
   }
-  // The job out at the end still reaches the final graph, trajectory and map.
-  while (loop_closer_ && slam_.loop_job_out()) {
+  // The job out at the end, and the search of the newest keyframe if it waited for it,
+  // still reach the final graph, trajectory and map.
+  while (loop_closer_) {
+    if (std::optional<slam::LoopJob> job = slam_.take_loop_job()) loop_closer_->submit(std::move(*job));
+    if (!slam_.loop_job_out()) break;
     std::optional<slam::LoopResult> result = loop_closer_->wait_take();
     if (!result) break;
     slam_.apply_loop_result(std::move(*result));

@@ -128,6 +128,23 @@ KeyframeGraph KeyframeGraph::without_trajectory() const {
   return copy;
 }
 
+std::vector<PlacedScan> KeyframeGraph::scans_since(std::size_t first, const KeyframeGraph &solved) const {
+  const std::size_t copied = std::min(solved.keyframes_.size(), keyframes_.size());
+  const Eigen::Isometry2d T_corrected_tracked =
+      copied == 0
+          ? Eigen::Isometry2d::Identity()
+          : solved.keyframes_[copied - 1].T_map_keyframe * keyframes_[copied - 1].T_map_keyframe.inverse();
+  std::vector<PlacedScan> scans;
+  for (std::size_t i = first; i < integration_order_.size(); ++i) {
+    const auto k = static_cast<std::size_t>(integration_order_[i].first);
+    const Eigen::Isometry2d pose =
+        k < copied ? solved.keyframes_[k].T_map_keyframe : T_corrected_tracked * keyframes_[k].T_map_keyframe;
+    scans.push_back(
+        {keyframes_[k].scans_keyframe[static_cast<std::size_t>(integration_order_[i].second)], pose});
+  }
+  return scans;
+}
+
 Eigen::Isometry2d KeyframeGraph::adopt(const KeyframeGraph &solved, std::size_t copied_edges) {
   const std::size_t copied = solved.keyframes_.size();
   if (copied == 0 || copied > keyframes_.size()) return Eigen::Isometry2d::Identity();

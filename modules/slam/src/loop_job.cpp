@@ -1,10 +1,20 @@
 #include "omnislam/slam/loop_job.hpp"
 
+#include "omnislam/slam/planar_pose.hpp"
+
 #include <utility>
 
 namespace omnislam::slam {
 
 LoopResult run_loop_job(LoopJob job) {
+  if (job.catch_up) {
+    LoopResult result = std::move(*job.catch_up);
+    for (const PlacedScan &placed : job.scans_since)
+      result.map->integrate(transformed(*placed.scan_keyframe, placed.T_map_keyframe));
+    result.map_integrations += job.scans_since.size();
+    ++result.catch_up_rounds;
+    return result;
+  }
   LoopResult result;
   result.generation = job.generation;
   result.copied_edges = job.edges;
@@ -29,6 +39,7 @@ LoopResult run_loop_job(LoopJob job) {
     const std::vector<MapPoint> none;
     result.map = graph.rebuilt_map(job.map, job.restored_points ? *job.restored_points : none,
                                    job.restored_integrations);
+    result.map_integrations = graph.integrations();
   }
   result.solved = std::move(graph);
   return result;

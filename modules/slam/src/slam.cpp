@@ -108,6 +108,7 @@ void Slam::resume(std::vector<MapPoint> points, int integrations, const Eigen::I
   last_loop_.reset();
   search_due_ = false;
   job_out_ = false;
+  catch_up_job_.reset();
   ++generation_;
   map_ = PointMap(config_.map, std::move(points), integrations);
   started_ = true;
@@ -168,16 +169,18 @@ Eigen::Isometry2d Slam::update_graph(const Points2 &scan_base, FrameEstimate &es
 }
 
 LoopJob Slam::make_loop_job() const {
-  return {generation_,
-          keyframes_.without_trajectory(),
-          keyframes_.graph().edges().size(),
-          pending_loop_,
-          last_loop_,
-          restored_points_,
-          restored_integrations_,
-          config_.loop_closure,
-          config_.icp,
-          config_.map};
+  LoopJob job;
+  job.generation = generation_;
+  job.graph = keyframes_.without_trajectory();
+  job.edges = keyframes_.graph().edges().size();
+  job.pending = pending_loop_;
+  job.last_loop = last_loop_;
+  job.restored_points = restored_points_;
+  job.restored_integrations = restored_integrations_;
+  job.config = config_.loop_closure;
+  job.icp = config_.icp;
+  job.map = config_.map;
+  return job;
 }
 
 Eigen::Isometry2d Slam::take_result(LoopResult result) {
@@ -194,7 +197,7 @@ Eigen::Isometry2d Slam::take_result(LoopResult result) {
   const Eigen::Isometry2d T_corrected_tracked = keyframes_.adopt(*result.solved, result.copied_edges);
   if (result.map) {
     // The rebuilt map holds the scans up to the job; those integrated since follow.
-    keyframes_.integrate_since(*result.map, result.solved->integrations());
+    keyframes_.integrate_since(*result.map, result.map_integrations);
     map_ = std::move(*result.map);
     rebuilt_since_frame_ = true;
   }
@@ -202,6 +205,11 @@ Eigen::Isometry2d Slam::take_result(LoopResult result) {
 }
 
 std::optional<LoopJob> Slam::take_loop_job() {
+  if (catch_up_job_) {
+    std::optional<LoopJob> job = std::move(catch_up_job_);
+    catch_up_job_.reset();
+    return job;
+  }
   if (!config_.loop_closure.background || !search_due_ || job_out_) return std::nullopt;
   search_due_ = false;
   job_out_ = true;
@@ -210,6 +218,18 @@ std::optional<LoopJob> Slam::take_loop_job() {
 
 void Slam::apply_loop_result(LoopResult result) {
   if (result.generation != generation_) return;  // made before a resume: another graph
+  const LoopClosureConfig &loops = config_.loop_closure;
+  if (result.map && result.solved && result.catch_up_rounds < loops.max_catch_up_rounds &&
+      keyframes_.integrations() >
+          result.map_integrations + static_cast<std::size_t>(loops.max_catch_up_scans)) {
+    // The worker integrates the scans tracked meanwhile, at their corrected poses.
+    LoopJob job;
+    job.generation = generation_;
+    job.scans_since = keyframes_.scans_since(result.map_integrations, *result.solved);
+    job.catch_up = std::make_shared<LoopResult>(std::move(result));
+    catch_up_job_ = std::move(job);
+    return;
+  }
   job_out_ = false;
   const Eigen::Isometry2d T_corrected_tracked = take_result(std::move(result));
   if (!closed_since_frame_) return;

@@ -4,6 +4,7 @@
 #include <Eigen/Geometry>
 #include <cstddef>
 #include <memory>
+#include <utility>
 #include <vector>
 
 #include "omnislam/slam/nearest_neighbors.hpp"
@@ -38,6 +39,12 @@ struct Keyframe {
   /// The integrated scans it holds, keyframe coordinates; immutable once stored, shared by
   /// every copy of the graph.
   std::vector<std::shared_ptr<const Points2>> scans_keyframe;
+};
+
+/// A stored scan and the pose it is integrated at.
+struct PlacedScan {
+  std::shared_ptr<const Points2> scan_keyframe;  ///< keyframe coordinates, shared with the graph
+  Eigen::Isometry2d T_map_keyframe = Eigen::Isometry2d::Identity();
 };
 
 class KeyframeGraph {
@@ -82,6 +89,9 @@ class KeyframeGraph {
   /// added here since the copy stay; the new keyframes move with the copy's newest
   /// keyframe. Returns that keyframe's correction (T_corrected_tracked, map frame).
   Eigen::Isometry2d adopt(const KeyframeGraph &solved, std::size_t copied_edges);
+  /// The stored scans from the `first`-th integrated one on, each with the pose it would
+  /// have once `solved` (as for adopt) is adopted.
+  [[nodiscard]] std::vector<PlacedScan> scans_since(std::size_t first, const KeyframeGraph &solved) const;
   /// Integrates into `map` the stored scans from the `first`-th integrated one on, at their
   /// keyframes' current poses (a map rebuilt from a copy, caught up with this graph).
   void integrate_since(PointMap &map, std::size_t first) const;

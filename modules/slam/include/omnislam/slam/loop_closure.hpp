@@ -67,6 +67,12 @@ struct LoopClosureConfig {
   /// A correction that moves no keyframe by more than this keeps the map (it is within
   /// half the map's fusion radius).
   double rebuild_min_shift_m = 0.025;
+  /// Background only: a map rebuilt on the worker that lags the tracking by more than this
+  /// many integrated scans goes back to the worker to catch up (at most
+  /// max_catch_up_rounds times) before it replaces the live map, so the tracking thread
+  /// integrates at most a few scans when it takes it.
+  int max_catch_up_scans = 2;
+  int max_catch_up_rounds = 3;
 };
 
 /// Why a loop hypothesis was accepted or not (the first failed check).

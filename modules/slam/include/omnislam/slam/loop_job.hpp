@@ -21,6 +21,8 @@
 
 namespace omnislam::slam {
 
+struct LoopResult;
+
 struct LoopJob {
   std::uint64_t generation = 0;  ///< Slam's, so a result from before a resume is ignored
   /// The graph when the job was made (without the per-frame trajectory); its newest
@@ -37,6 +39,10 @@ struct LoopJob {
   LoopClosureConfig config;
   TrimmedIcpConfig icp;
   PointMapConfig map;
+  /// A catch-up job instead of a search: the result whose rebuilt map lags the tracking,
+  /// and the scans integrated since, at their corrected poses, to integrate into it.
+  std::shared_ptr<LoopResult> catch_up;
+  std::vector<PlacedScan> scans_since;
 };
 
 struct LoopResult {
@@ -49,14 +55,17 @@ struct LoopResult {
   std::optional<KeyframeGraph> solved;
   KeyframeGraph::Correction correction;
   /// The map rebuilt from the optimised keyframes, when the correction moved one by more
-  /// than rebuild_min_shift_m; it holds the scans integrated up to the job.
+  /// than rebuild_min_shift_m; it holds the graph's first map_integrations scans.
   std::optional<PointMap> map;
+  std::size_t map_integrations = 0;
+  int catch_up_rounds = 0;  ///< catch-up jobs this result went through
 };
 
 /// Searches a loop at the job's newest keyframe, confirms it against `pending` (the loops
 /// of two consecutive searched keyframes must imply the same correction), and when
 /// confirmed adds both loop edges, optimises the graph and, after a large enough
-/// correction, rebuilds the map. Pure computation on the caller's thread.
+/// correction, rebuilds the map. A catch-up job instead integrates its scans into its
+/// result's map. Pure computation on the caller's thread.
 [[nodiscard]] LoopResult run_loop_job(LoopJob job);
 
 }  // namespace omnislam::slam

@@ -130,7 +130,9 @@ class Slam {
   /// searched as one, the newest, after its result came back); otherwise nullopt. The job
   /// shares the stored scans and may be run on any thread (run_loop_job).
   [[nodiscard]] std::optional<LoopJob> take_loop_job();
-  /// Takes the result of the job that is out, between two process() calls: a confirmed
+  /// Takes the result of the job that is out, between two process() calls. A rebuilt map
+  /// that lags the tracking by more than loop_closure.max_catch_up_scans goes back out as
+  /// a catch-up job (take_loop_job; the job stays out) instead. Otherwise: a confirmed
   /// loop's optimised graph (with the keyframes made since moved by the correction of the
   /// job's newest one), the rebuilt map caught up with the scans integrated since, and the
   /// live pose, the odometry anchor and the recent scans moved by the same correction, so
@@ -170,11 +172,12 @@ class Slam {
   std::optional<LoopMatch> pending_loop_;  ///< the previous keyframe's verified loop, to be confirmed
   std::optional<LoopMatch> last_loop_;     ///< the last loop edge added (narrows the next search)
   int loop_closures_ = 0;
-  bool search_due_ = false;           ///< a keyframe was made since the last job was taken
-  bool job_out_ = false;              ///< a job was taken, its result not applied yet
-  std::uint64_t generation_ = 0;      ///< counts resumes: older jobs' results are ignored
-  bool closed_since_frame_ = false;   ///< a result closed a loop since the last frame
-  bool rebuilt_since_frame_ = false;  ///< ... and rebuilt the map
+  bool search_due_ = false;              ///< a keyframe was made since the last job was taken
+  bool job_out_ = false;                 ///< a job was taken, its result not applied yet
+  std::optional<LoopJob> catch_up_job_;  ///< a result's map to catch up on the worker
+  std::uint64_t generation_ = 0;         ///< counts resumes: older jobs' results are ignored
+  bool closed_since_frame_ = false;      ///< a result closed a loop since the last frame
+  bool rebuilt_since_frame_ = false;     ///< ... and rebuilt the map
   /// A resumed map: the base every rebuild starts from (shared with the jobs).
   std::shared_ptr<const std::vector<MapPoint>> restored_points_;
   int restored_integrations_ = 0;
