@@ -1,15 +1,24 @@
 // Pipeline benchmark (not a test): throughput replaying as fast as possible from memory
 // (images decoded beforehand, the dataset looped), then capture->pose latency with live
-// input at 30 Hz. Run it through scripts/bench-pipeline (2 cores).
+// input at 30 Hz. Both runs also print the per-frame SLAM stage p99 of the first and the
+// last loop of the dataset (issue 13: the 20th loop within 20% of the first), and between
+// them the SLAM stage alone on one thread over the looped scans gives the same figure
+// without the other threads' noise. Run it through scripts/bench-pipeline (2 cores).
 //
 //   bench_pipeline [DATASET] [--loops N] [--live-seconds S] [--rate HZ] [--no-loop-closure]
+//                  [--loop-closure inline|background]
+// --loop-closure sets where loop closure runs in both runs; by default the pipeline's
+// choice by mode: inline in the throughput (replay) run, background in the live run.
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <memory>
+#include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "omnislam/io/dataset.hpp"
@@ -17,6 +26,7 @@
 #include "omnislam/io/image_file.hpp"
 #include "omnislam/io/poses.hpp"
 #include "omnislam/pipeline/pipeline.hpp"
+#include "omnislam/stereo/scan_reconstructor.hpp"
 
 using namespace omnislam;
 
@@ -54,6 +64,60 @@ pipeline::FrameSource looped(const Data &data, std::size_t frames) {
   };
 }
 
+double p99(std::vector<double> values) {
+  if (values.empty()) return 0.0;
+  std::sort(values.begin(), values.end());
+  return values[static_cast<std::size_t>(0.99 * static_cast<double>(values.size() - 1))];
+}
+
+// The SLAM stage's time of every frame that got through, by loop of the dataset.
+struct PerLoop {
+  std::size_t frames_per_loop = 1;
+  std::vector<std::vector<double>> slam_ms;
+
+  void add(const pipeline::Frame &frame) {
+    const std::size_t loop = static_cast<std::size_t>(frame.sequence - 1) / frames_per_loop;
+    if (slam_ms.size() <= loop) slam_ms.resize(loop + 1);
+    slam_ms[loop].push_back(frame.timings.stage_ms[pipeline::kSlam]);
+  }
+  /// The first and the last complete loop of `frames` captured.
+  void print(std::size_t frames) const {
+    const std::size_t loops = std::min(frames / frames_per_loop, slam_ms.size());
+    if (loops < 2) return;
+    const double first = p99(slam_ms.front()), last = p99(slam_ms[loops - 1]);
+    std::printf("  per-frame SLAM p99: loop 1 %.2f ms, loop %zu %.2f ms (ratio %.2f)\n", first, loops, last,
+                first > 0.0 ? last / first : 0.0);
+  }
+};
+
+// The SLAM stage alone on one thread over the dataset's scans looped `loops` times: its
+// per-frame cost by loop, without the other stages' threads competing for the cores. With
+// loop closure in the background, each job is run between two frames, untimed (the
+// worker's share), and its result is applied in the next frame's timing.
+void per_loop_on_one_thread(const Data &data, const std::vector<slam::Points2> &scans,
+                            slam::SlamConfig config, int loops, bool background) {
+  config.loop_closure.background = background;
+  slam::Slam slam(config);
+  std::vector<std::vector<double>> ms(static_cast<std::size_t>(loops));
+  const std::size_t n = scans.size();
+  for (std::size_t f = 0; f < n * static_cast<std::size_t>(loops); ++f) {
+    std::optional<slam::LoopResult> result;
+    if (std::optional<slam::LoopJob> job = slam.take_loop_job()) result = slam::run_loop_job(std::move(*job));
+    const auto begin = std::chrono::steady_clock::now();
+    if (result) slam.apply_loop_result(std::move(*result));
+    (void)slam.process(scans[f % n], data.odometry[f % n]);
+    ms[f / n].push_back(
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - begin).count());
+  }
+  std::printf(
+      "  one thread, loop closure %-10s: per-frame SLAM p99 loop 1 %.2f ms, loop %d %.2f ms (ratio %.2f); "
+      "%d closures\n",
+      !config.loop_closure.enabled ? "off"
+      : background                 ? "background"
+                                   : "inline",
+      p99(ms.front()), loops, p99(ms.back()), p99(ms.back()) / p99(ms.front()), slam.loop_closures());
+}
+
 }  // namespace
 
 int main(int argc, char **argv) {
@@ -61,6 +125,7 @@ int main(int argc, char **argv) {
   int loops = 20;
   double live_seconds = 10.0, rate_hz = 30.0;
   slam::SlamConfig slam_config;  // the defaults: loop closure on
+  pipeline::LoopClosureThread loop_closure = pipeline::LoopClosureThread::kByMode;
   for (int i = 1; i < argc; ++i) {
     const std::string arg = argv[i];
     if (arg == "--loops" && i + 1 < argc) {
@@ -71,29 +136,65 @@ int main(int argc, char **argv) {
       rate_hz = std::atof(argv[++i]);
     } else if (arg == "--no-loop-closure") {
       slam_config.loop_closure.enabled = false;
+    } else if (arg == "--loop-closure" && i + 1 < argc) {
+      const std::string where = argv[++i];
+      loop_closure =
+          where == "inline" ? pipeline::LoopClosureThread::kInline : pipeline::LoopClosureThread::kBackground;
     } else {
       dataset = arg;
     }
   }
   const Data data = load(dataset);
+  std::vector<slam::Points2> scans;  // the front-end's output for each image, for the one-thread runs
+  {
+    stereo::ScanReconstructor front_end(data.scan);
+    stereo::LocalScan scan;
+    for (const cv::Mat &image : data.images) {
+      front_end.unwarp(image);
+      front_end.detect_edges();
+      front_end.select_edges();
+      front_end.match();
+      front_end.triangulate(scan);
+      slam::Points2 points;
+      for (const stereo::ScanPoint &p : scan.points) points.emplace_back(p.x_m, p.y_m);
+      scans.push_back(std::move(points));
+    }
+  }
 
   {  // 1. Throughput: replay mode (blocking queues), input as fast as memory gives it.
     const std::size_t frames = data.images.size() * static_cast<std::size_t>(loops);
-    pipeline::Pipeline pipeline(data.scan, slam_config, {}, {});
+    pipeline::PipelineConfig config;
+    config.loop_closure = loop_closure;
+    PerLoop per_loop{data.images.size(), {}};
+    pipeline::Sinks sinks;
+    sinks.frame = [&](const pipeline::Frame &frame) { per_loop.add(frame); };
+    pipeline::Pipeline pipeline(data.scan, slam_config, config, sinks);
     const auto start = std::chrono::steady_clock::now();
     pipeline.run(looped(data, frames));
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     std::printf("throughput: %zu frames in %.3f s = %.1f frames/s (as fast as possible, from memory)\n",
                 frames, seconds, static_cast<double>(frames) / seconds);
+    std::printf("  loop closures %d, keyframes %zu, background loop jobs %llu\n",
+                pipeline.slam().loop_closures(), pipeline.slam().keyframes().keyframes().size(),
+                static_cast<unsigned long long>(pipeline.loop_jobs_done()));
+    per_loop.print(frames);
   }
-  {  // 2. Latency: live mode at a camera's rate.
+  // 2. The SLAM stage alone, by loop (issue 13: the 20th loop within 20% of the first).
+  if (loops >= 2) {
+    if (slam_config.loop_closure.enabled) per_loop_on_one_thread(data, scans, slam_config, loops, false);
+    per_loop_on_one_thread(data, scans, slam_config, loops, slam_config.loop_closure.enabled);
+  }
+  {  // 3. Latency: live mode at a camera's rate.
     pipeline::PipelineConfig config;
     config.mode = pipeline::Mode::kLive;
     config.input_rate_hz = rate_hz;
     config.profile_window = 1 << 20;
+    config.loop_closure = loop_closure;
     pipeline::ProfileSnapshot profile;
+    PerLoop per_loop{data.images.size(), {}};
     pipeline::Sinks sinks;
     sinks.profile = [&](const pipeline::ProfileSnapshot &p) { profile = p; };
+    sinks.frame = [&](const pipeline::Frame &frame) { per_loop.add(frame); };
     const auto frames = static_cast<std::size_t>(live_seconds * rate_hz);
     pipeline::Pipeline pipeline(data.scan, slam_config, config, sinks);
     pipeline.run(looped(data, frames));
@@ -105,7 +206,10 @@ int main(int argc, char **argv) {
     for (std::size_t s = 0; s < pipeline::kStages.size(); ++s) {
       std::printf(" %s %.2f", std::string(pipeline::kStages[s]).c_str(), profile.stages[s].mean_ms);
     }
-    std::printf("\n");
+    std::printf("\n  loop closures %d, keyframes %zu, background loop jobs %llu\n",
+                pipeline.slam().loop_closures(), pipeline.slam().keyframes().keyframes().size(),
+                static_cast<unsigned long long>(pipeline.loop_jobs_done()));
+    per_loop.print(frames);
   }
   return 0;
 }

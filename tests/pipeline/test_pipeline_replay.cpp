@@ -232,3 +232,49 @@ TEST_CASE("relocalising pipeline: its pose found on a saved map, an operator's p
     CHECK(far.without_pose == kFrames - 4);
   }
 }
+
+TEST_CASE("pipeline with background loop closure: every job's result lands, none is out at the end") {
+  const Input &in = input();
+  pipeline::PipelineConfig config;
+  config.loop_closure = pipeline::LoopClosureThread::kBackground;
+  std::vector<Eigen::Isometry2d> truth_out, estimate_out;
+  int keyframes = 0;
+  pipeline::Sinks sinks;
+  sinks.frame = [&](const pipeline::Frame &f) {
+    truth_out.push_back(in.ground_truth[static_cast<std::size_t>(f.stamp_s)]);
+    estimate_out.push_back(f.estimate.T_map_base);
+    keyframes += f.estimate.keyframe ? 1 : 0;
+  };
+  pipeline::Pipeline pipeline(in.scan, {}, config, sinks);
+  // The 12 frames looped 6 times: from the third loop on, keyframes have loop candidates.
+  pipeline.run(memory_source(in, kFrames * 6));
+  REQUIRE(truth_out.size() == static_cast<std::size_t>(kFrames * 6));
+  CHECK(keyframes > 2);
+  CHECK(pipeline.loop_jobs_done() > 0);
+  CHECK_FALSE(pipeline.slam().loop_job_out());
+  CHECK(pipeline.slam().trajectory().size() == truth_out.size());
+  double max_error_m = 0.0;
+  for (std::size_t i = 0; i < truth_out.size(); ++i) {
+    const Eigen::Isometry2d truth_map = truth_out.front().inverse() * truth_out[i];
+    max_error_m = std::max(max_error_m, (estimate_out[i].translation() - truth_map.translation()).norm());
+  }
+  CHECK(max_error_m < 0.1);
+}
+
+TEST_CASE("pipeline with background loop closure: stop() with a job in flight drains and joins") {
+  const Input &in = input();
+  pipeline::PipelineConfig config;
+  config.mode = pipeline::Mode::kLive;  // background by mode
+  std::uint64_t delivered = 0;
+  pipeline::Sinks sinks;
+  sinks.frame = [&](const pipeline::Frame &) { ++delivered; };
+  pipeline::Pipeline pipeline(in.scan, {}, config, sinks);
+  pipeline.start(memory_source(in, 1 << 30));  // never ends by itself
+  while (pipeline.loop_jobs_done() < 2 && pipeline.frames_out() < 2000) std::this_thread::sleep_for(5ms);
+  pipeline.stop();
+  pipeline.join();
+  CHECK(pipeline.finished());
+  CHECK(pipeline.loop_jobs_done() >= 2);
+  CHECK_FALSE(pipeline.slam().loop_job_out());
+  CHECK(delivered == pipeline.frames_out());
+}

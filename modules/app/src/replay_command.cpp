@@ -36,6 +36,8 @@ struct ReplayOptions {
   std::uint64_t degrade_seed = 1;
   std::string map_file;  ///< a snapshot to localize on (--map, with --localize)
   bool localize = false;
+  std::string loop_closure = "inline";  ///< where loop closure runs (--loop-closure)
+  double rate_hz = 0.0;                 ///< input paced to this rate (--rate); 0: as fast as it goes
 };
 
 // Odometry as the robot reports it (the dataset's, or a given TUM or thesis-format file),
@@ -76,6 +78,12 @@ void run_replay(const ReplayOptions &options, std::optional<std::uint64_t> degra
   pipeline::PipelineConfig pipeline_config;
   pipeline_config.mode = pipeline::Mode::kReplay;
   pipeline_config.map_every_integration = true;  // the thesis's mapaN.txt after every image
+  // Inline (the default) keeps the run deterministic; background is the service's, for
+  // measuring it (its result depends on timing).
+  pipeline_config.loop_closure = options.loop_closure == "background"
+                                     ? pipeline::LoopClosureThread::kBackground
+                                     : pipeline::LoopClosureThread::kInline;
+  pipeline_config.input_rate_hz = options.rate_hz;
   pipeline::Sinks sinks;
   // The occupancy grid of the run (map.yaml + map.pgm): the frames' boundary points and free
   // floor, built at the end from the final (optimised) poses of trajectory.tum.
@@ -159,6 +167,16 @@ void add_replay_command(CLI::App &app) {
           "without changing the map; frames before the pose is confirmed are left out of trajectory.tum")
       ->needs(map);
   map->needs(command->get_option("--localize"));
+  command
+      ->add_option("--loop-closure", options->loop_closure,
+                   "where loop closure runs: inline (at each keyframe, deterministic) or background (on a "
+                   "thread of its own, as omnislamd live; the result depends on timing)")
+      ->check(CLI::IsMember({"inline", "background"}))
+      ->capture_default_str();
+  command
+      ->add_option("--rate", options->rate_hz,
+                   "feed the frames at this rate (Hz), as a camera would; 0: at once")
+      ->check(CLI::NonNegativeNumber);
   command->callback([options, degrade_seed] {
     run_replay(*options, degrade_seed->count() > 0 ? std::optional(options->degrade_seed) : std::nullopt);
   });

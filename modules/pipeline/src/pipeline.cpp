@@ -41,6 +41,23 @@ slam::Points2 scan_points(const stereo::LocalScan &scan) {
   return points;
 }
 
+bool background_loop_closure(const PipelineConfig &config) {
+  switch (config.loop_closure) {
+    case LoopClosureThread::kInline:
+      return false;
+    case LoopClosureThread::kBackground:
+      return true;
+    case LoopClosureThread::kByMode:
+      break;
+  }
+  return config.mode == Mode::kLive;
+}
+
+slam::SlamConfig with_loop_closure_thread(slam::SlamConfig slam, const PipelineConfig &config) {
+  slam.loop_closure.background = slam.loop_closure.enabled && background_loop_closure(config);
+  return slam;
+}
+
 }  // namespace
 
 Pipeline::Pipeline(const stereo::ScanConfig &scan, const slam::SlamConfig &slam, PipelineConfig config,
@@ -48,7 +65,7 @@ Pipeline::Pipeline(const stereo::ScanConfig &scan, const slam::SlamConfig &slam,
     : scan_config_(scan),
       config_(config),
       sinks_(std::move(sinks)),
-      slam_(slam),
+      slam_(with_loop_closure_thread(slam, config)),
       queues_{Queue(config.queue_capacity), Queue(config.queue_capacity), Queue(config.queue_capacity),
               Queue(config.queue_capacity)} {}
 
@@ -84,6 +101,8 @@ void Pipeline::start(FrameSource source) {
   // with the stages for the cores (and, uninstrumented, hides its work from TSan). Canny and
   // remap give the same pixels either way.
   cv::setNumThreads(0);
+  if (with_loop_closure_thread({}, config_).loop_closure.background)
+    loop_closer_ = std::make_unique<LoopCloser>(config_.loop_closure_nice);
   threads_[0] =
       std::thread([this, source = std::move(source)]() mutable { capture_loop(std::move(source)); });
   threads_[1] = std::thread([this] { frontend_loop(); });
@@ -98,6 +117,7 @@ void Pipeline::join() {
   for (std::thread &thread : threads_) {
     if (thread.joinable()) thread.join();
   }
+  loop_closer_.reset();  // the SLAM thread, its only user, has ended
   error_ = !capture_error_.empty() ? capture_error_ : publish_error_;
 }
 
@@ -285,8 +305,18 @@ void Pipeline::slam_loop() {
       if (frame->pose_reset) narrow_search(*frame->pose_reset, odometry);
       relocalize_frame(*frame, odometry);
     } else {
+      // Background loop closure: a finished job's correction reaches this frame's
+      // prediction, and a new keyframe's job leaves with it.
+      if (loop_closer_) {
+        while (std::optional<slam::LoopResult> result = loop_closer_->try_take())
+          slam_.apply_loop_result(std::move(*result));
+      }
       if (frame->pose_reset) slam_.set_pose(frame->pose_reset->T_map_base, frame->pose_reset->covariance);
       frame->estimate = slam_.process(scan_points(frame->scan), odometry);
+      if (loop_closer_) {
+        if (std::optional<slam::LoopJob> job = slam_.take_loop_job()) loop_closer_->submit(std::move(*job));
+        loop_jobs_done_.store(loop_closer_->jobs_done(), std::memory_order_relaxed);
+      }
     }
     clock.lap(kSlam);
     const Clock::time_point now = Clock::now();
@@ -312,6 +342,16 @@ void Pipeline::slam_loop() {
     busy(3, false);
     forward(queues_[kPublish], frame);
   }
+  // The job out at the end, and the search of the newest keyframe if it waited for it,
+  // still reach the final graph, trajectory and map.
+  while (loop_closer_) {
+    if (std::optional<slam::LoopJob> job = slam_.take_loop_job()) loop_closer_->submit(std::move(*job));
+    if (!slam_.loop_job_out()) break;
+    std::optional<slam::LoopResult> result = loop_closer_->wait_take();
+    if (!result) break;
+    slam_.apply_loop_result(std::move(*result));
+  }
+  if (loop_closer_) loop_jobs_done_.store(loop_closer_->jobs_done(), std::memory_order_relaxed);
   queues_[kPublish].close();
 }
 

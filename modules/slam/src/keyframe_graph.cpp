@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <memory>
+#include <utility>
 
 #include "omnislam/slam/planar_pose.hpp"
 
@@ -58,7 +60,8 @@ bool KeyframeGraph::add_integrated(const Points2 &scan_base, const Eigen::Isomet
     keyframes_.push_back({T_map_base, path_m_, {}});
   }
   frames_.push_back(anchor(T_map_base));
-  keyframes_.back().scans_keyframe.push_back(transformed(scan_base, frames_.back().T_keyframe_base));
+  keyframes_.back().scans_keyframe.push_back(
+      std::make_shared<const Points2>(transformed(scan_base, frames_.back().T_keyframe_base)));
   integration_order_.emplace_back(last(), static_cast<int>(keyframes_.back().scans_keyframe.size()) - 1);
   return is_keyframe;
 }
@@ -93,8 +96,8 @@ Points2 KeyframeGraph::submap(int center, double path_radius_m, double max_path_
   for (const Keyframe &keyframe : keyframes_) {
     if (std::abs(keyframe.path_m - middle.path_m) > path_radius_m || keyframe.path_m > max_path_m) continue;
     const Eigen::Isometry2d T_center_keyframe = T_center_map * keyframe.T_map_keyframe;
-    for (const Points2 &scan : keyframe.scans_keyframe)
-      for (const Point2 &p : scan) points.push_back(T_center_keyframe * p);
+    for (const auto &scan : keyframe.scans_keyframe)
+      for (const Point2 &p : *scan) points.push_back(T_center_keyframe * p);
   }
   return points;
 }
@@ -102,12 +105,62 @@ Points2 KeyframeGraph::submap(int center, double path_radius_m, double max_path_
 PointMap KeyframeGraph::rebuilt_map(const PointMapConfig &config, const std::vector<MapPoint> &base,
                                     int base_integrations) const {
   PointMap map = base.empty() ? PointMap(config) : PointMap(config, base, base_integrations);
-  for (const auto &[k, scan] : integration_order_) {
+  integrate_since(map, 0);
+  return map;
+}
+
+void KeyframeGraph::integrate_since(PointMap &map, std::size_t first) const {
+  for (std::size_t i = first; i < integration_order_.size(); ++i) {
+    const auto &[k, scan] = integration_order_[i];
     const Keyframe &keyframe = keyframes_[static_cast<std::size_t>(k)];
     map.integrate(
-        transformed(keyframe.scans_keyframe[static_cast<std::size_t>(scan)], keyframe.T_map_keyframe));
+        transformed(*keyframe.scans_keyframe[static_cast<std::size_t>(scan)], keyframe.T_map_keyframe));
   }
-  return map;
+}
+
+KeyframeGraph KeyframeGraph::without_trajectory() const {
+  KeyframeGraph copy(config_);
+  copy.keyframes_ = keyframes_;
+  copy.integration_order_ = integration_order_;
+  copy.graph_ = graph_;
+  copy.path_m_ = path_m_;
+  copy.last_frame_ = last_frame_;
+  return copy;
+}
+
+std::vector<PlacedScan> KeyframeGraph::scans_since(std::size_t first, const KeyframeGraph &solved) const {
+  const std::size_t copied = std::min(solved.keyframes_.size(), keyframes_.size());
+  const Eigen::Isometry2d T_corrected_tracked =
+      copied == 0
+          ? Eigen::Isometry2d::Identity()
+          : solved.keyframes_[copied - 1].T_map_keyframe * keyframes_[copied - 1].T_map_keyframe.inverse();
+  std::vector<PlacedScan> scans;
+  for (std::size_t i = first; i < integration_order_.size(); ++i) {
+    const auto k = static_cast<std::size_t>(integration_order_[i].first);
+    const Eigen::Isometry2d pose =
+        k < copied ? solved.keyframes_[k].T_map_keyframe : T_corrected_tracked * keyframes_[k].T_map_keyframe;
+    scans.push_back(
+        {keyframes_[k].scans_keyframe[static_cast<std::size_t>(integration_order_[i].second)], pose});
+  }
+  return scans;
+}
+
+Eigen::Isometry2d KeyframeGraph::adopt(const KeyframeGraph &solved, std::size_t copied_edges) {
+  const std::size_t copied = solved.keyframes_.size();
+  if (copied == 0 || copied > keyframes_.size()) return Eigen::Isometry2d::Identity();
+  const Eigen::Isometry2d T_corrected_tracked =
+      solved.keyframes_[copied - 1].T_map_keyframe * keyframes_[copied - 1].T_map_keyframe.inverse();
+  for (std::size_t k = 0; k < keyframes_.size(); ++k) {
+    Eigen::Isometry2d &pose = keyframes_[k].T_map_keyframe;
+    pose = k < copied ? solved.keyframes_[k].T_map_keyframe : T_corrected_tracked * pose;
+  }
+  // The solved graph (its loop edges, without those it rejected), then what was added here
+  // since the copy: the new keyframes' nodes and their sequential edges.
+  PoseGraph graph = solved.graph_;
+  for (std::size_t k = copied; k < keyframes_.size(); ++k) graph.add_node(keyframes_[k].T_map_keyframe);
+  for (std::size_t e = copied_edges; e < graph_.edges().size(); ++e) graph.add_edge(graph_.edges()[e]);
+  graph_ = std::move(graph);
+  return T_corrected_tracked;
 }
 
 std::vector<Eigen::Isometry2d> KeyframeGraph::trajectory() const {

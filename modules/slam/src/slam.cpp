@@ -109,12 +109,17 @@ FrameEstimate Slam::register_scan(const Points2 &scan_base, const Eigen::Isometr
 void Slam::resume(std::vector<MapPoint> points, int integrations, const Eigen::Isometry2d &T_map_base,
                   const Eigen::Matrix3d &covariance, const std::optional<Eigen::Isometry2d> &T_odom_base) {
   if (config_.loop_closure.enabled) {
-    restored_points_ = points;  // the graph's corrections move what is added to it, not this
+    // The graph's corrections move what is added to it, not this.
+    restored_points_ = std::make_shared<const std::vector<MapPoint>>(points);
     restored_integrations_ = integrations;
   }
   keyframes_ = KeyframeGraph(config_.loop_closure.keyframes);
   pending_loop_.reset();
   last_loop_.reset();
+  search_due_ = false;
+  job_out_ = false;
+  catch_up_job_.reset();
+  ++generation_;
   map_ = PointMap(config_.map, std::move(points), integrations);
   started_ = true;
   anchor_T_odom_base_ = T_odom_base;
@@ -161,43 +166,90 @@ FrameEstimate Slam::seed_map(const Points2 &scan_base) {
 }
 
 Eigen::Isometry2d Slam::update_graph(const Points2 &scan_base, FrameEstimate &estimate) {
-  const LoopClosureConfig &loops = config_.loop_closure;
   estimate.keyframe = keyframes_.add_integrated(scan_base, estimate.T_map_base, estimate.covariance);
   if (!estimate.keyframe) return estimate.T_map_base;
+  search_due_ = true;
+  if (config_.loop_closure.background) return estimate.T_map_base;  // the caller runs the job
+  search_due_ = false;
+  const Eigen::Isometry2d T_corrected_tracked = take_result(run_loop_job(make_loop_job()));
+  estimate.loop_closed = closed_since_frame_;
+  estimate.map_rebuilt = rebuilt_since_frame_;
+  closed_since_frame_ = rebuilt_since_frame_ = false;
+  if (!estimate.loop_closed) return estimate.T_map_base;
+  for (Points2 &scan : recent_scans_map_) scan = transformed(scan, T_corrected_tracked);
+  return keyframes_.keyframes().back().T_map_keyframe;  // this frame is that keyframe
+}
 
-  // A loop hypothesis is verified at this keyframe, and used only when the previous
-  // keyframe's agrees with it (one match can be fooled; two in a row rarely are).
-  const LoopMatch match = search_loop(keyframes_, loops, config_.icp, last_loop_);
+LoopJob Slam::make_loop_job() const {
+  LoopJob job;
+  job.generation = generation_;
+  job.graph = keyframes_.without_trajectory();
+  job.edges = keyframes_.graph().edges().size();
+  job.pending = pending_loop_;
+  job.last_loop = last_loop_;
+  job.restored_points = restored_points_;
+  job.restored_integrations = restored_integrations_;
+  job.config = config_.loop_closure;
+  job.icp = config_.icp;
+  job.map = config_.map;
+  return job;
+}
+
+Eigen::Isometry2d Slam::take_result(LoopResult result) {
+  const LoopMatch &match = result.match;
   if (match.status != LoopStatus::kAccepted) {
     pending_loop_.reset();
-    return estimate.T_map_base;
+    return Eigen::Isometry2d::Identity();
   }
-  const bool confirmed = pending_loop_ && pending_loop_->current == match.current - 1 &&
-                         agree(keyframes_, *pending_loop_, match, loops);
-  if (!confirmed) {
-    pending_loop_ = match;
-    return estimate.T_map_base;
-  }
-  if (!keyframes_.has_loop(pending_loop_->current))
-    keyframes_.add_loop(pending_loop_->candidate, pending_loop_->current, pending_loop_->T_candidate_current,
-                        pending_loop_->covariance);
-  keyframes_.add_loop(match.candidate, match.current, match.T_candidate_current, match.covariance);
   pending_loop_ = match;
+  if (!result.confirmed || !result.solved) return Eigen::Isometry2d::Identity();
   last_loop_ = match;
-
-  // Optimise (warm start: the graph holds the current estimate), then let the map and the
-  // tracking state follow the corrected keyframes.
-  const KeyframeGraph::Correction correction = keyframes_.optimize(loops.graph);
   ++loop_closures_;
-  estimate.loop_closed = true;
-  if (correction.max_shift_m > loops.rebuild_min_shift_m) {
-    map_ = keyframes_.rebuilt_map(config_.map, restored_points_, restored_integrations_);
-    estimate.map_rebuilt = true;
+  closed_since_frame_ = true;
+  const Eigen::Isometry2d T_corrected_tracked = keyframes_.adopt(*result.solved, result.copied_edges);
+  if (result.map) {
+    // The rebuilt map holds the scans up to the job; those integrated since follow.
+    keyframes_.integrate_since(*result.map, result.map_integrations);
+    map_ = std::move(*result.map);
+    rebuilt_since_frame_ = true;
   }
-  const Eigen::Isometry2d corrected = keyframes_.keyframes().back().T_map_keyframe;
-  const Eigen::Isometry2d T_corrected_tracked = corrected * estimate.T_map_base.inverse();
+  return T_corrected_tracked;
+}
+
+std::optional<LoopJob> Slam::take_loop_job() {
+  if (catch_up_job_) {
+    std::optional<LoopJob> job = std::move(catch_up_job_);
+    catch_up_job_.reset();
+    return job;
+  }
+  if (!config_.loop_closure.background || !search_due_ || job_out_) return std::nullopt;
+  search_due_ = false;
+  job_out_ = true;
+  return make_loop_job();
+}
+
+void Slam::apply_loop_result(LoopResult result) {
+  if (result.generation != generation_) return;  // made before a resume: another graph
+  const LoopClosureConfig &loops = config_.loop_closure;
+  if (result.map && result.solved && result.catch_up_rounds < loops.max_catch_up_rounds &&
+      keyframes_.integrations() >
+          result.map_integrations + static_cast<std::size_t>(loops.max_catch_up_scans)) {
+    // The worker integrates the scans tracked meanwhile, at their corrected poses.
+    LoopJob job;
+    job.generation = generation_;
+    job.scans_since = keyframes_.scans_since(result.map_integrations, *result.solved);
+    job.catch_up = std::make_shared<LoopResult>(std::move(result));
+    catch_up_job_ = std::move(job);
+    return;
+  }
+  job_out_ = false;
+  const Eigen::Isometry2d T_corrected_tracked = take_result(std::move(result));
+  if (!closed_since_frame_) return;
+  // The tracking state follows the correction: the next frame is predicted from the
+  // corrected pose and registered against the corrected map.
+  previous_.T_map_base = T_corrected_tracked * previous_.T_map_base;
+  anchor_T_map_base_ = T_corrected_tracked * anchor_T_map_base_;
   for (Points2 &scan : recent_scans_map_) scan = transformed(scan, T_corrected_tracked);
-  return corrected;
 }
 
 FrameEstimate Slam::process(const Points2 &scan_base, const std::optional<Eigen::Isometry2d> &T_odom_base) {
@@ -263,6 +315,10 @@ FrameEstimate Slam::process(const Points2 &scan_base, const std::optional<Eigen:
   }
   if (!in_graph) keyframes_.add_pose(estimate.T_map_base);
   estimate.trajectory_index = keyframes_.frame_count() - 1;
+  // A background job's result applied before this frame.
+  estimate.loop_closed = estimate.loop_closed || closed_since_frame_;
+  estimate.map_rebuilt = estimate.map_rebuilt || rebuilt_since_frame_;
+  closed_since_frame_ = rebuilt_since_frame_ = false;
   previous_failed_ = !estimate.integrated;
   if (T_odom_base) set_anchor(*T_odom_base, estimate.T_map_base);
   last_step_ = previous_.T_map_base.inverse() * estimate.T_map_base;  // extrapolated through gaps

@@ -10,6 +10,7 @@
 #include <thread>
 
 #include "omnislam/pipeline/frame.hpp"
+#include "omnislam/pipeline/loop_closer.hpp"
 #include "omnislam/pipeline/profiler.hpp"
 #include "omnislam/pipeline/spsc_queue.hpp"
 #include "omnislam/slam/relocalizer.hpp"
@@ -19,7 +20,8 @@
 /// @file
 /// The staged real-time pipeline (architecture.md "Pipeline"): capture -> front-end
 /// (unwarp, Canny, edge selection) -> stereo (DP matching, triangulation) -> SLAM ->
-/// publish, one thread each, joined by bounded SPSC queues of owned frames.
+/// publish, one thread each, joined by bounded SPSC queues of owned frames; with
+/// LoopClosureThread::kBackground a sixth thread (LoopCloser) runs the loop closure.
 
 namespace omnislam::pipeline {
 
@@ -28,8 +30,20 @@ enum class Mode {
   kLive,    ///< capture never blocks: a frame that finds the first queue full is dropped and counted
 };
 
+/// Where loop closure (search, pose-graph solve, map rebuild) runs.
+enum class LoopClosureThread {
+  kByMode,      ///< kInline in Mode::kReplay, kBackground in Mode::kLive
+  kInline,      ///< on the SLAM stage at each keyframe: the correction lands on that frame, deterministic
+  kBackground,  ///< on a worker thread of its own; the SLAM stage takes the result at a later frame
+};
+
 struct PipelineConfig {
   Mode mode = Mode::kReplay;
+  LoopClosureThread loop_closure = LoopClosureThread::kByMode;
+  /// Nice value of the background loop-closure thread (0..19): at 19 a stage thread that
+  /// wants the core it shares gets ~98% of it, so a search or map rebuild of a few hundred
+  /// ms does not stretch the frames' latency; the worker uses what the stages leave idle.
+  int loop_closure_nice = 19;
   std::size_t queue_capacity = 4;      ///< frames per queue (each holds an image: memory is bounded)
   double input_rate_hz = 0.0;          ///< capture paces the source to this rate; 0 = as fast as it delivers
   bool map_every_integration = false;  ///< attach the map to every integrated frame (thesis mapaN.txt)
@@ -98,6 +112,11 @@ class Pipeline {
   /// True once the publish stage has handed on the last frame (join() will not wait). Thread-safe.
   [[nodiscard]] bool finished() const { return finished_.load(std::memory_order_acquire); }
 
+  /// Loop jobs the background worker finished (0 with inline loop closure). Thread-safe.
+  [[nodiscard]] std::uint64_t loop_jobs_done() const {
+    return loop_jobs_done_.load(std::memory_order_relaxed);
+  }
+
   /// The SLAM state. Only after join().
   [[nodiscard]] const slam::Slam &slam() const { return slam_; }
   /// The first error of the source or a sink (which ends the run early); empty if none. After join().
@@ -146,11 +165,13 @@ class Pipeline {
   std::atomic<std::uint64_t> dropped_{0};
   std::atomic<std::uint64_t> out_{0};
   std::atomic<bool> finished_{false};
+  std::atomic<std::uint64_t> loop_jobs_done_{0};
   std::array<std::atomic<std::int64_t>, kThreads.size()> busy_since_ns_{};
   std::string capture_error_;  ///< written by capture, read after join
   std::string publish_error_;  ///< written by publish, read after join
   std::string error_;
   std::array<std::thread, kThreads.size()> threads_;
+  std::unique_ptr<LoopCloser> loop_closer_;  ///< background loop closure, used by the SLAM thread only
   bool started_ = false;
 };
 

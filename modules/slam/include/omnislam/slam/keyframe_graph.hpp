@@ -2,6 +2,9 @@
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
+#include <cstddef>
+#include <memory>
+#include <utility>
 #include <vector>
 
 #include "omnislam/slam/nearest_neighbors.hpp"
@@ -14,7 +17,8 @@
 /// the last one; it keeps every integrated frame's scan until the next keyframe, in its own
 /// coordinates, so the map can be rebuilt from the optimised keyframe poses. Every frame
 /// (keyframe or not) is remembered relative to the keyframe it followed, so the whole
-/// trajectory follows the graph. Not thread-safe.
+/// trajectory follows the graph. Not thread-safe; a copy shares the stored scans (immutable)
+/// with the original, so copies may be read on other threads while the original grows.
 
 namespace omnislam::slam {
 
@@ -31,8 +35,16 @@ struct KeyframeConfig {
 
 struct Keyframe {
   Eigen::Isometry2d T_map_keyframe = Eigen::Isometry2d::Identity();  ///< the graph's current value
-  double path_m = 0.0;                  ///< distance travelled from the first keyframe
-  std::vector<Points2> scans_keyframe;  ///< the integrated scans it holds, keyframe coordinates
+  double path_m = 0.0;  ///< distance travelled from the first keyframe
+  /// The integrated scans it holds, keyframe coordinates; immutable once stored, shared by
+  /// every copy of the graph.
+  std::vector<std::shared_ptr<const Points2>> scans_keyframe;
+};
+
+/// A stored scan and the pose it is integrated at.
+struct PlacedScan {
+  std::shared_ptr<const Points2> scan_keyframe;  ///< keyframe coordinates, shared with the graph
+  Eigen::Isometry2d T_map_keyframe = Eigen::Isometry2d::Identity();
 };
 
 class KeyframeGraph {
@@ -68,6 +80,23 @@ class KeyframeGraph {
   /// keyframe's current pose, integrated in the order they were first integrated.
   [[nodiscard]] PointMap rebuilt_map(const PointMapConfig &config, const std::vector<MapPoint> &base,
                                      int base_integrations) const;
+
+  /// A copy for a loop search on another thread: keyframes (their scans shared, not
+  /// copied), pose graph and integration order, without the per-frame trajectory.
+  [[nodiscard]] KeyframeGraph without_trajectory() const;
+  /// Takes the poses and edges of `solved`, a copy of this graph made when it had
+  /// `copied_edges` edges and then given loop edges and optimised. Keyframes and edges
+  /// added here since the copy stay; the new keyframes move with the copy's newest
+  /// keyframe. Returns that keyframe's correction (T_corrected_tracked, map frame).
+  Eigen::Isometry2d adopt(const KeyframeGraph &solved, std::size_t copied_edges);
+  /// The stored scans from the `first`-th integrated one on, each with the pose it would
+  /// have once `solved` (as for adopt) is adopted.
+  [[nodiscard]] std::vector<PlacedScan> scans_since(std::size_t first, const KeyframeGraph &solved) const;
+  /// Integrates into `map` the stored scans from the `first`-th integrated one on, at their
+  /// keyframes' current poses (a map rebuilt from a copy, caught up with this graph).
+  void integrate_since(PointMap &map, std::size_t first) const;
+  /// Integrated scans recorded so far.
+  [[nodiscard]] std::size_t integrations() const { return integration_order_.size(); }
 
   /// Every recorded frame's pose following its keyframe's current pose (frames before the
   /// first keyframe keep the pose they were recorded with).

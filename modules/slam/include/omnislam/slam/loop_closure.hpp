@@ -15,12 +15,18 @@
 /// verified by a correlative search (a grid over x, y, yaw scored on the candidate's local
 /// submap) and Trimmed ICP, and a loop is accepted only when the fit is good, overlaps, is
 /// not degenerate, clearly beats any other hypothesis, and the next keyframe agrees. Plain
-/// computation on its caller's thread; its cost per keyframe is bounded by max_candidates.
+/// computation on its caller's thread; its cost per keyframe is bounded by max_candidates
+/// (loop_job.hpp packs it as a job for another thread).
 
 namespace omnislam::slam {
 
 struct LoopClosureConfig {
   bool enabled = true;
+  /// false: Slam::process runs each keyframe's loop job itself, so a correction lands on
+  /// that keyframe's frame (deterministic: replay). true: Slam hands the job out
+  /// (Slam::take_loop_job) for its caller to run beside the tracking and give back
+  /// (Slam::apply_loop_result) at a later frame (the service: pose latency stays flat).
+  bool background = false;
   KeyframeConfig keyframes;
   PoseGraphConfig graph;
   /// A candidate lies at least this far back along the path (closer ones are already in
@@ -61,6 +67,12 @@ struct LoopClosureConfig {
   /// A correction that moves no keyframe by more than this keeps the map (it is within
   /// half the map's fusion radius).
   double rebuild_min_shift_m = 0.025;
+  /// Background only: a map rebuilt on the worker that lags the tracking by more than this
+  /// many integrated scans goes back to the worker to catch up (at most
+  /// max_catch_up_rounds times) before it replaces the live map, so the tracking thread
+  /// integrates at most a few scans when it takes it.
+  int max_catch_up_scans = 2;
+  int max_catch_up_rounds = 3;
 };
 
 /// Why a loop hypothesis was accepted or not (the first failed check).

@@ -1,11 +1,14 @@
 #pragma once
 
 #include <Eigen/Geometry>
+#include <cstdint>
 #include <deque>
+#include <memory>
 #include <optional>
 
 #include "omnislam/slam/keyframe_graph.hpp"
 #include "omnislam/slam/loop_closure.hpp"
+#include "omnislam/slam/loop_job.hpp"
 #include "omnislam/slam/nearest_neighbors.hpp"
 #include "omnislam/slam/point_map.hpp"
 #include "omnislam/slam/trimmed_icp.hpp"
@@ -85,7 +88,9 @@ struct FrameEstimate {
   TrimmedIcpResult registration;                         ///< the accepted one, or the last tried
   Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();  ///< (x, y, yaw) in the map frame
   bool keyframe = false;                                 ///< the frame became a keyframe of the pose graph
-  bool loop_closed = false;  ///< a loop closure corrected the graph (and T_map_base) at this frame
+  /// A loop closure corrected the graph (and T_map_base) at this frame: its own keyframe's
+  /// (inline loop closure) or a job's result applied just before it (background).
+  bool loop_closed = false;
   bool map_rebuilt = false;  ///< ... and the map was rebuilt from the optimised keyframes
   /// This frame's index in Slam::trajectory() (-1: not recorded there, e.g. the frame a
   /// relocalisation confirmed; the trajectory starts afresh at resume()).
@@ -132,6 +137,23 @@ class Slam {
   [[nodiscard]] const KeyframeGraph &keyframes() const { return keyframes_; }
   [[nodiscard]] int loop_closures() const { return loop_closures_; }
 
+  /// With loop_closure.background: the loop job of the newest keyframe, once a keyframe was
+  /// made and no job is out (at most one at a time: keyframes made while one is out are
+  /// searched as one, the newest, after its result came back); otherwise nullopt. The job
+  /// shares the stored scans and may be run on any thread (run_loop_job).
+  [[nodiscard]] std::optional<LoopJob> take_loop_job();
+  /// Takes the result of the job that is out, between two process() calls. A rebuilt map
+  /// that lags the tracking by more than loop_closure.max_catch_up_scans goes back out as
+  /// a catch-up job (take_loop_job; the job stays out) instead. Otherwise: a confirmed
+  /// loop's optimised graph (with the keyframes made since moved by the correction of the
+  /// job's newest one), the rebuilt map caught up with the scans integrated since, and the
+  /// live pose, the odometry anchor and the recent scans moved by the same correction, so
+  /// the next frame is predicted and registered in the corrected map. The next estimate
+  /// reports loop_closed / map_rebuilt. A result from before a resume() is ignored.
+  void apply_loop_result(LoopResult result);
+  /// A job was taken and its result not applied yet.
+  [[nodiscard]] bool loop_job_out() const { return job_out_; }
+
  private:
   [[nodiscard]] bool accept(const TrimmedIcpResult &registration, const Eigen::Isometry2d &predicted,
                             const Eigen::Isometry2d &estimate, double srel_limit_percent) const;
@@ -147,10 +169,14 @@ class Slam {
                                              const Eigen::Isometry2d &predicted,
                                              const Eigen::Isometry2d &estimate) const;
 
-  /// Adds an integrated frame to the keyframe graph; at a new keyframe, searches for a loop
-  /// and, when one is confirmed, optimises the graph and rebuilds the map. Returns the
-  /// frame's pose after any correction.
+  /// Adds an integrated frame to the keyframe graph; at a new keyframe, unless loop closure
+  /// runs in the background, runs its loop job (search, and when a loop is confirmed,
+  /// optimisation and map rebuild). Returns the frame's pose after any correction.
   [[nodiscard]] Eigen::Isometry2d update_graph(const Points2 &scan_base, FrameEstimate &estimate);
+  [[nodiscard]] LoopJob make_loop_job() const;
+  /// Applies a job's result to the graph and the map; returns the correction of the live
+  /// pose (T_corrected_tracked: identity when no loop was confirmed).
+  [[nodiscard]] Eigen::Isometry2d take_result(LoopResult result);
 
   SlamConfig config_;
   PointMap map_;
@@ -158,7 +184,14 @@ class Slam {
   std::optional<LoopMatch> pending_loop_;  ///< the previous keyframe's verified loop, to be confirmed
   std::optional<LoopMatch> last_loop_;     ///< the last loop edge added (narrows the next search)
   int loop_closures_ = 0;
-  std::vector<MapPoint> restored_points_;  ///< a resumed map: the base every rebuild starts from
+  bool search_due_ = false;              ///< a keyframe was made since the last job was taken
+  bool job_out_ = false;                 ///< a job was taken, its result not applied yet
+  std::optional<LoopJob> catch_up_job_;  ///< a result's map to catch up on the worker
+  std::uint64_t generation_ = 0;         ///< counts resumes: older jobs' results are ignored
+  bool closed_since_frame_ = false;      ///< a result closed a loop since the last frame
+  bool rebuilt_since_frame_ = false;     ///< ... and rebuilt the map
+  /// A resumed map: the base every rebuild starts from (shared with the jobs).
+  std::shared_ptr<const std::vector<MapPoint>> restored_points_;
   int restored_integrations_ = 0;
   bool started_ = false;
   /// The last frame that had odometry: its odometry pose and its estimate. Predictions
