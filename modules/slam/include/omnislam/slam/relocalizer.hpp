@@ -44,9 +44,12 @@ struct RelocalizerConfig {
   /// Poses closer than this are the same hypothesis.
   double distinct_m = 0.5;
   double distinct_rad = 0.35;
-  /// A refinement is accepted as in the SLAM: it fits and overlaps.
+  /// A refinement is accepted when it fits (as in the SLAM) and explains the scan: at most
+  /// twice outlier_share of its points farther than 0.1 m from the map (true poses on the
+  /// bundled rooms, every camera factor on: 92-99% within; the sim room's end placed in the
+  /// office's map: 71-75%). The SLAM's 0.7 is for consecutive frames, not for a whole map.
   double max_rms_m = 0.04;
-  double min_inlier_share = 0.7;
+  double min_inlier_share = 0.8;
   /// Frames the sole surviving hypothesis must have been tracked for.
   int confirm_frames = 3;
   int min_scan_points = 20;
