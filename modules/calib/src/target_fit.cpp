@@ -217,8 +217,10 @@ bool solve(JointProblem &joint, int max_iterations, TargetFitResult &result) {
 // The rig's (and the floor's) standard deviations: every residual is in its own standard
 // deviations once the corners' weight is set, so the covariance needs no further scaling.
 bool covariance_of(JointProblem &joint, TargetFitResult &result) {
+  // Ceres's default (sparse QR): its dense SVD path runs Eigen's BDCSVD inside libceres,
+  // whose allocations then mix with this build's Eigen instantiations (AddressSanitizer:
+  // bad free). A rank-deficient fit is reported as not estimable either way.
   ceres::Covariance::Options options;
-  options.algorithm_type = ceres::DENSE_SVD;
   ceres::Covariance covariance(options);
   std::vector<std::pair<const double *, const double *>> blocks{{joint.rig.data(), joint.rig.data()}};
   const bool floor = !std::isnan(joint.floor_z_m);
