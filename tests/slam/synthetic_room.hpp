@@ -1,6 +1,7 @@
 #pragma once
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 #include <optional>
@@ -98,5 +99,29 @@ inline slam::Points2 scan_from(const std::vector<Segment> &walls, const Eigen::I
 }
 
 inline Eigen::Isometry2d pose(double x, double y, double yaw) { return slam::planar_pose(x, y, yaw); }
+
+/// `laps` tours along the closed polyline `corners` (first = last), facing each leg, in steps
+/// of about 0.2 m; the tour ends back at its first pose.
+inline std::vector<Eigen::Isometry2d> laps_along(const std::vector<Eigen::Vector2d> &corners, int laps) {
+  std::vector<Eigen::Isometry2d> truth;
+  for (int lap = 0; lap < laps; ++lap) {
+    for (std::size_t c = 0; c + 1 < corners.size(); ++c) {
+      const Eigen::Vector2d a = corners[c], b = corners[c + 1];
+      const double yaw = std::atan2(b.y() - a.y(), b.x() - a.x());
+      const int steps = std::max(1, static_cast<int>(std::round((b - a).norm() / 0.2)));
+      for (int s = 0; s < steps; ++s) {
+        const Eigen::Vector2d p = a + (b - a) * (static_cast<double>(s) / steps);
+        truth.push_back(pose(p.x(), p.y(), yaw));
+      }
+    }
+  }
+  truth.push_back(truth.front());
+  return truth;
+}
+
+/// The corners of a tour of l_room() along its corridor-like legs.
+inline std::vector<Eigen::Vector2d> l_room_tour() {
+  return {{0, 0}, {5, 0}, {5, 0.6}, {1.5, 0.6}, {1.5, 3}, {0, 3}, {0, 0}};
+}
 
 }  // namespace omnislam::test

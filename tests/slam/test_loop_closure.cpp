@@ -39,22 +39,7 @@ std::vector<Segment> pillared_hall(double period_m = 1.0) {
 
 // Laps around the hall (out along y = -0.6, back along y = +0.6), 0.2 m steps, turning.
 std::vector<Eigen::Isometry2d> hall_laps(int laps) {
-  const std::vector<Eigen::Vector2d> corners = {
-      {-4.5, -0.6}, {4.5, -0.6}, {4.5, 0.6}, {-4.5, 0.6}, {-4.5, -0.6}};
-  std::vector<Eigen::Isometry2d> truth;
-  for (int lap = 0; lap < laps; ++lap) {
-    for (std::size_t c = 0; c + 1 < corners.size(); ++c) {
-      const Eigen::Vector2d a = corners[c], b = corners[c + 1];
-      const double yaw = std::atan2(b.y() - a.y(), b.x() - a.x());
-      const int steps = std::max(1, static_cast<int>(std::round((b - a).norm() / 0.2)));
-      for (int s = 0; s < steps; ++s) {
-        const Eigen::Vector2d p = a + (b - a) * (static_cast<double>(s) / steps);
-        truth.push_back(pose(p.x(), p.y(), yaw));
-      }
-    }
-  }
-  truth.push_back(truth.front());
-  return truth;
+  return omnislam::test::laps_along({{-4.5, -0.6}, {4.5, -0.6}, {4.5, 0.6}, {-4.5, 0.6}, {-4.5, -0.6}}, laps);
 }
 
 // A scan of the hall in base_link from the true pose (3 m range, 1 cm noise).
@@ -183,21 +168,7 @@ TEST_CASE("loop closure: no false loop closure in a hall of identical bays", "[s
 }
 
 TEST_CASE("loop closure: two laps of the L-room close the loop and stay accurate", "[slam][loop]") {
-  const std::vector<Eigen::Vector2d> corners = {{0, 0},   {5, 0}, {5, 0.6}, {1.5, 0.6},
-                                                {1.5, 3}, {0, 3}, {0, 0}};
-  std::vector<Eigen::Isometry2d> truth;
-  for (int lap = 0; lap < 2; ++lap) {
-    for (std::size_t c = 0; c + 1 < corners.size(); ++c) {
-      const Eigen::Vector2d a = corners[c], b = corners[c + 1];
-      const double yaw = std::atan2(b.y() - a.y(), b.x() - a.x());
-      const int steps = std::max(1, static_cast<int>(std::round((b - a).norm() / 0.2)));
-      for (int s = 0; s < steps; ++s) {
-        const Eigen::Vector2d p = a + (b - a) * (static_cast<double>(s) / steps);
-        truth.push_back(pose(p.x(), p.y(), yaw));
-      }
-    }
-  }
-  truth.push_back(truth.front());
+  const std::vector<Eigen::Isometry2d> truth = omnislam::test::laps_along(omnislam::test::l_room_tour(), 2);
   SlamConfig without;
   without.loop_closure.enabled = false;
   for (std::uint64_t seed : {1u, 2u}) {

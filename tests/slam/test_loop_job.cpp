@@ -18,24 +18,9 @@ using omnislam::test::pose;
 
 namespace {
 
-// Laps of the L-room along its corridor-like legs, 0.2 m steps (as test_loop_closure.cpp).
+// Laps of the L-room along its corridor-like legs, 0.2 m steps.
 std::vector<Eigen::Isometry2d> l_room_laps(int laps) {
-  const std::vector<Eigen::Vector2d> corners = {{0, 0},   {5, 0}, {5, 0.6}, {1.5, 0.6},
-                                                {1.5, 3}, {0, 3}, {0, 0}};
-  std::vector<Eigen::Isometry2d> truth;
-  for (int lap = 0; lap < laps; ++lap) {
-    for (std::size_t c = 0; c + 1 < corners.size(); ++c) {
-      const Eigen::Vector2d a = corners[c], b = corners[c + 1];
-      const double yaw = std::atan2(b.y() - a.y(), b.x() - a.x());
-      const int steps = std::max(1, static_cast<int>(std::round((b - a).norm() / 0.2)));
-      for (int s = 0; s < steps; ++s) {
-        const Eigen::Vector2d p = a + (b - a) * (static_cast<double>(s) / steps);
-        truth.push_back(pose(p.x(), p.y(), yaw));
-      }
-    }
-  }
-  truth.push_back(truth.front());
-  return truth;
+  return omnislam::test::laps_along(omnislam::test::l_room_tour(), laps);
 }
 
 SlamConfig background() {
