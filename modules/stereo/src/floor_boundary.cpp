@@ -57,12 +57,15 @@ float FloorBoundaryFinder::gain(int inner_row, float outer_row) const {
 FloorBoundaryFinder::FloorBoundaryFinder(const FloorBoundaryConfig &config)
     : config_(config), decision_llr_(std::log((1.0 - config.error_rate) / config.error_rate)) {}
 
-float FloorBoundaryFinder::outer_at(float row, int column) const {
+float FloorBoundaryFinder::interpolate(const float *line, float row) const {
   const float clamped = std::clamp(row, 0.0f, static_cast<float>(rows_ - 1));
   const int below = std::min(rows_ - 2, static_cast<int>(clamped));
   const float fraction = clamped - static_cast<float>(below);
-  const float *line = outer_.ptr<float>(column);
   return line[below] + fraction * (line[below + 1] - line[below]);
+}
+
+float FloorBoundaryFinder::outer_at(float row, int column) const {
+  return interpolate(outer_.ptr<float>(column), row);
 }
 
 void FloorBoundaryFinder::prepare(const cv::Mat &inner_texture, const cv::Mat &outer_texture) {
@@ -87,12 +90,12 @@ void FloorBoundaryFinder::prepare(const cv::Mat &inner_texture, const cv::Mat &o
   floor_residual_.create(columns, rows, CV_32FC1);
   for (int column = 0; column < columns; ++column) {  // column-major, like the textures
     float *residual = floor_residual_.ptr<float>(column);
+    const float *inner = inner_.ptr<float>(column), *outer = outer_.ptr<float>(column);
     for (int row = 0; row < rows; ++row) {
       const float g = floor_gain_[static_cast<std::size_t>(row)];
-      residual[row] =
-          std::isfinite(g)
-              ? std::abs(inner_px(row, column) - g * outer_at(geometry_->floor_outer_row(row), column))
-              : kNaN;
+      residual[row] = std::isfinite(g)
+                          ? std::abs(inner[row] - g * interpolate(outer, geometry_->floor_outer_row(row)))
+                          : kNaN;
     }
   }
   measure_noise_scale();
@@ -193,20 +196,28 @@ FloorBoundaryFinder::Verdict FloorBoundaryFinder::floor_or_vertical(int column, 
                                                                     float contact_row) const {
   // Wald's sequential test, rows outwards from the edge. Rows inside the edge's own blur,
   // in either lobe, measure the sub-pixel placement of a steep edge rather than the
-  // hypotheses, and do not vote.
+  // hypotheses, and do not vote. (The walk is the front-end's hottest loop: the column's
+  // lines and the two tabulated bases around the edge are looked up once.)
+  const int base = static_cast<int>(edge_row);
+  if (base + 1 >= rows_) return Verdict::kUndecided;  // no surface tabulated that far
+  const float fraction = edge_row - static_cast<float>(base);
+  const float *near_base = geometry_->vertical_outer_rows(base);
+  const float *far_base = geometry_->vertical_outer_rows(base + 1);
+  const float *floor_residual = floor_residual_.ptr<float>(column);
+  const float *inner = inner_.ptr<float>(column);
+  const float *outer = outer_.ptr<float>(column);
   double llr = 0.0;
-  for (int row = static_cast<int>(edge_row) - kEdgeBlurRows; row >= 0; --row) {
-    const float floor_residual = floor_residual_.ptr<float>(column)[row];
-    const float vertical_row = geometry_->vertical_outer_row_at(row, edge_row);
-    if (!std::isfinite(floor_residual) || !std::isfinite(vertical_row)) continue;
+  for (int row = base - kEdgeBlurRows; row >= 0; --row) {
+    const float vertical_row = near_base[row] + fraction * (far_base[row] - near_base[row]);
+    if (!std::isfinite(floor_residual[row]) || !std::isfinite(vertical_row)) continue;
     if (std::abs(vertical_row - contact_row) <= kEdgeBlurRows) continue;
     const float vertical_residual =
-        std::abs(inner_px(row, column) - gain(row, vertical_row) * outer_at(vertical_row, column));
+        std::abs(inner[row] - gain(row, vertical_row) * interpolate(outer, vertical_row));
     // Laplace log-likelihood ratio of the row, less a dead zone: two residuals of independent
     // noise differ by up to about twice the scale, and what the model itself leaves (sub-pixel
     // base, interpolation, the gain estimate) is smaller still; neither must add up over a
     // long uniform wall as if it were evidence.
-    llr += kRowCorrelation * row_vote(vertical_residual, floor_residual);
+    llr += kRowCorrelation * row_vote(vertical_residual, floor_residual[row]);
     if (llr >= decision_llr_) return Verdict::kFloor;
     if (llr <= -decision_llr_) return Verdict::kVertical;
   }

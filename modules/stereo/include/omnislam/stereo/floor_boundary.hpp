@@ -95,6 +95,8 @@ class FloorBoundaryFinder {
   enum class Verdict { kFloor, kVertical, kUndecided };
   [[nodiscard]] Verdict floor_or_vertical(int column, float edge_row, float contact_row) const;
   [[nodiscard]] float outer_at(float row, int column) const;
+  /// One column-major line (a column of a lobe) at a fractional row, clamped to the lobe.
+  [[nodiscard]] float interpolate(const float *line, float row) const;
   /// Vote of one row for the hypothesis with `residual_for` (positive) over the other,
   /// in residual scales, less the dead zone, capped.
   [[nodiscard]] float row_vote(float residual_against, float residual_for) const;

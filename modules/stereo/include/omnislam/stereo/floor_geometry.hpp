@@ -39,6 +39,10 @@ class FloorGeometry {
   [[nodiscard]] float vertical_outer_row(int row, int base_row) const {
     return vertical_outer_row_[index(base_row) * static_cast<std::size_t>(rows_) + index(row)];
   }
+  /// vertical_outer_row(row, base_row) of every row, indexed by row (NaN from base_row on).
+  [[nodiscard]] const float *vertical_outer_rows(int base_row) const {
+    return vertical_outer_row_.data() + index(base_row) * static_cast<std::size_t>(rows_);
+  }
   /// Image radius (px) of a panorama row of each lobe (mirror.md sec. 0).
   [[nodiscard]] float inner_radius_px(float row) const { return inner_radius_offset_px_ - row; }
   [[nodiscard]] float outer_radius_px(float row) const { return outer_radius_offset_px_ - row; }
