@@ -110,3 +110,29 @@ def shifted(image, du, dv):
     out = ((1 - fu) * (1 - fv) * take(iv, iu) + fu * (1 - fv) * take(iv, iu + 1)
            + (1 - fu) * fv * take(iv + 1, iu) + fu * fv * take(iv + 1, iu + 1))
     return np.clip(np.rint(out), 0, 255).astype(np.uint8)
+
+
+def covariance_consistency(run_dir: Path, dataset_dir: Path) -> tuple[float, float]:
+    """(mean NEES of (x, y, yaw), share of positions inside their own 95% ellipse) of a run's
+    published poses (trajectory_online.tum) and covariance.csv against the dataset's ground
+    truth, matched by time stamp; frames with a singular covariance (the first) are left out.
+    Computed here from the files, independently of `omnislam evaluate`."""
+    truth = {round(t, 6): p for t, p in read_tum(Path(dataset_dir) / "groundtruth.tum")}
+    published = {round(t, 6): p for t, p in read_tum(Path(run_dir) / "trajectory_online.tum")}
+    nees, inside = [], 0
+    with open(Path(run_dir) / "covariance.csv") as fh:
+        for row in csv.DictReader(fh):
+            t = round(float(row["t"]), 6)
+            if t not in truth or t not in published:
+                continue
+            xx, xy, yy = float(row["xx_m2"]), float(row["xy_m2"]), float(row["yy_m2"])
+            xa, ya, aa = float(row["xyaw_m_rad"]), float(row["yyaw_m_rad"]), float(row["yawyaw_rad2"])
+            cov = np.array([[xx, xy, xa], [xy, yy, ya], [xa, ya, aa]])
+            if np.linalg.det(cov) <= 0.0:
+                continue
+            e = np.array(published[t]) - np.array(truth[t])
+            e[2] = angle_diff(published[t][2], truth[t][2])
+            nees.append(float(e @ np.linalg.solve(cov, e)))
+            inside += float(e[:2] @ np.linalg.solve(cov[:2, :2], e[:2])) <= 5.991  # chi2(2) 95%
+    assert nees, f"no frame of {run_dir} has a covariance to check"
+    return float(np.mean(nees)), inside / len(nees)

@@ -1,3 +1,4 @@
+#include <Eigen/Eigenvalues>
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <random>
@@ -124,4 +125,36 @@ TEST_CASE("trimmed ICP: a position prior holds the pose along a plain corridor, 
   CHECK(std::abs(free.T_model_sample.translation().x() - 0.3) > 0.05);  // slid along it without
   // Across the corridor the walls, not the prior, decide: the prior said y = 0.
   CHECK(std::abs(free.T_model_sample.translation().y() - 0.05) < 0.005);
+}
+
+TEST_CASE("trimmed ICP: the cluster-robust covariance covers an error shared by a wall's points",
+          "[slam][icp][covariance]") {
+  // Two scans of the same room from the same place; in the sample every point beyond x > 2 m
+  // (one wall seen from inside) reads 6 mm long, as a front-end's range bias on one surface
+  // does. The independent-residual covariance takes the ~hundred points as a hundred
+  // measurements; the pose error the bias causes lies far outside it, but within the
+  // cluster-robust one, which is never smaller in any direction.
+  const auto walls = omnislam::test::l_room();
+  std::mt19937_64 rng(5);
+  const Eigen::Isometry2d T_map_scan = pose(1.0, 1.0, 0.0);
+  const Points2 model_scan = omnislam::test::scan_from(walls, T_map_scan, rng, 0.002);
+  Points2 sample = omnislam::test::scan_from(walls, T_map_scan, rng, 0.002);
+  for (auto &p : sample) {
+    if ((T_map_scan * p).x() > 1.8) p *= 1.0 + 0.006 / p.norm();
+  }
+  const auto result =
+      register_trimmed_icp(NearestNeighbors(model_scan), sample, Eigen::Isometry2d::Identity());
+  REQUIRE(result.valid);
+  const Eigen::Vector3d error(result.T_model_sample.translation().x(),
+                              result.T_model_sample.translation().y(), yaw_rad_of(result.T_model_sample));
+  const double nees_independent = error.dot(result.covariance.inverse() * error);
+  const double nees_robust = error.dot(result.robust_covariance.inverse() * error);
+  INFO("error " << error.transpose() << " NEES independent " << nees_independent << " robust "
+                << nees_robust);
+  CHECK(error.head<2>().norm() > 0.0005);  // the bias moved the fit
+  CHECK(nees_independent > 16.27);         // outside the 99.9% region of the independent estimate
+  CHECK(nees_robust < 16.27);              // inside the robust one's
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> difference(result.robust_covariance -
+                                                                  result.covariance);
+  CHECK(difference.eigenvalues().minCoeff() > -1e-15);
 }

@@ -253,6 +253,7 @@ void read_slam(YamlSection &section, slam::SlamConfig &slam) {
   section.read("max_iterations", slam.icp.max_iterations);
   section.read("estimate_scale", slam.icp.estimate_scale);
   section.read("keep_global_minimum", slam.icp.keep_global_minimum);
+  section.read("covariance_sectors", slam.icp.covariance_sectors);
   section.read("use_srel_test", slam.use_srel_test);
   section.read("srel_limit_percent", slam.srel_limit_percent);
   section.read("srel_relax_percent", slam.srel_relax_percent);
@@ -278,6 +279,8 @@ void read_slam(YamlSection &section, slam::SlamConfig &slam) {
                        [&slam](YamlSection &loops) { read_loop_closure(loops, slam.loop_closure); });
   if (!(slam.icp.overlap > 0.0 && slam.icp.overlap <= 1.0)) section.fail("overlap", "must be in (0, 1]");
   if (!(slam.icp.initial_search_radius_m > 0.0)) section.fail("initial_search_radius_m", "must be positive");
+  if (slam.icp.covariance_sectors < 1 || slam.icp.covariance_sectors > 360)
+    section.fail("covariance_sectors", "must be in 1..360");
   if (slam.icp.max_iterations < 1 || slam.icp.max_iterations > 1000) {
     section.fail("max_iterations", "must be in 1..1000");
   }

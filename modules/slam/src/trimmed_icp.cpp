@@ -1,9 +1,11 @@
 #include "omnislam/slam/trimmed_icp.hpp"
 
 #include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <numbers>
 #include <vector>
 
 namespace omnislam::slam {
@@ -144,6 +146,52 @@ Eigen::Matrix3d covariance_of(const std::vector<Pair> &pairs, const Motion &moti
   return std::max(error_m2, 1e-8) * eq.JtJ.inverse();
 }
 
+// Cluster-robust covariance (the sandwich A^-1 B A^-1 with A = J^T J and B the sum over
+// clusters of the outer product of each cluster's score J_g^T r_g; G / (G - 1), the usual
+// small-sample correction): residuals are free to be correlated inside a cluster, and only
+// the clusters are taken as independent. Clusters are bearing sectors of the sample frame.
+Eigen::Matrix3d robust_covariance_of(const std::vector<Pair> &pairs, const Motion &motion, int sectors,
+                                     const Eigen::Matrix3d &independent) {
+  if (sectors < 2) return independent;
+  std::vector<Eigen::Vector3d> scores(static_cast<std::size_t>(sectors), Eigen::Vector3d::Zero());
+  std::vector<bool> used(static_cast<std::size_t>(sectors), false);
+  Eigen::Matrix3d A = Eigen::Matrix3d::Zero();
+  for (const Pair &pair : pairs) {
+    const Point2 moved = motion.apply(pair.sample);
+    Eigen::Matrix<double, 2, 3> J;
+    J << 1.0, 0.0, -moved.y(), 0.0, 1.0, moved.x();
+    const double bearing = std::atan2(pair.sample.y(), pair.sample.x()) + std::numbers::pi;
+    const auto sector = std::min(sectors - 1, static_cast<int>(bearing / (2.0 * std::numbers::pi) * sectors));
+    Eigen::Vector3d score;
+    if (!pair.normal.isZero()) {
+      const Eigen::RowVector3d row = pair.normal.transpose() * J;
+      A += row.transpose() * row;
+      score = row.transpose() * pair.normal.dot(moved - pair.model);
+    } else {
+      A += J.transpose() * J;
+      score = J.transpose() * (moved - pair.model);
+    }
+    scores[static_cast<std::size_t>(sector)] += score;
+    used[static_cast<std::size_t>(sector)] = true;
+  }
+  const auto clusters = static_cast<double>(std::count(used.begin(), used.end(), true));
+  if (clusters < 2.0 || std::abs(A.determinant()) < 1e-12) return independent;
+  Eigen::Matrix3d B = Eigen::Matrix3d::Zero();
+  for (const Eigen::Vector3d &score : scores) B += score * score.transpose();
+  const Eigen::Matrix3d A_inverse = A.inverse();
+  const Eigen::Matrix3d sandwich = clusters / (clusters - 1.0) * A_inverse * B * A_inverse;
+  // Never more confident than the independent estimate in any direction: in coordinates
+  // where that one is the identity, the sandwich's variances below 1 are raised to 1.
+  const Eigen::LLT<Eigen::Matrix3d> independent_factor(independent);
+  if (independent_factor.info() != Eigen::Success) return independent;
+  const Eigen::Matrix3d L = independent_factor.matrixL();
+  const Eigen::Matrix3d L_inverse = L.inverse();
+  const Eigen::Matrix3d whitened = L_inverse * sandwich * L_inverse.transpose();
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> axes(0.5 * (whitened + whitened.transpose()));
+  const Eigen::Vector3d raised = axes.eigenvalues().cwiseMax(1.0);
+  return L * axes.eigenvectors() * raised.asDiagonal() * axes.eigenvectors().transpose() * L.transpose();
+}
+
 }  // namespace
 
 TrimmedIcpResult register_trimmed_icp(const NearestNeighbors &model, const Points2 &sample,
@@ -210,6 +258,8 @@ TrimmedIcpResult register_trimmed_icp(const NearestNeighbors &model, const Point
   for (const Point2 &p : sample) inliers += model.nearest(returned.apply(p), kInlierDistanceM) ? 1 : 0;
   result.inlier_share = static_cast<double>(inliers) / static_cast<double>(sample.size());
   result.covariance = covariance_of(pairs, returned, result.final_error_m2);
+  result.robust_covariance =
+      robust_covariance_of(pairs, returned, config.covariance_sectors, result.covariance);
   return result;
 }
 

@@ -157,6 +157,9 @@ class Slam {
  private:
   [[nodiscard]] bool accept(const TrimmedIcpResult &registration, const Eigen::Isometry2d &predicted,
                             const Eigen::Isometry2d &estimate, double srel_limit_percent) const;
+  /// The covariance published with `estimate`, `step` the odometry motion it was predicted by.
+  [[nodiscard]] Eigen::Matrix3d published_covariance(const FrameEstimate &estimate,
+                                                     const Eigen::Isometry2d &step) const;
   [[nodiscard]] FrameEstimate register_scan(const Points2 &scan_base, const Eigen::Isometry2d &predicted);
   /// How far beyond a scan at its predicted pose the map must be indexed for a registration
   /// to see all it would see in the whole map: the first search radius, the largest

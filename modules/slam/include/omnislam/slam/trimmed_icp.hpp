@@ -30,6 +30,9 @@ struct TrimmedIcpConfig {
   double min_relative_change = 1e-4;     ///< stop when e changes less than this between iterations
   bool estimate_scale = false;           ///< point-to-point only: also estimate a scale (thesis)
   bool keep_global_minimum = true;       ///< return the best iterate if the last is > 10% worse
+  /// Bearing sectors of the sample frame whose pairs' residuals robust_covariance treats as
+  /// possibly correlated (one cluster each); 45 deg is about one wall seen from inside a room.
+  int covariance_sectors = 8;
 };
 
 struct TrimmedIcpResult {
@@ -45,6 +48,12 @@ struct TrimmedIcpResult {
   std::size_t kept_pairs = 0;  ///< trimmed pairs at the returned transform
   double inlier_share = 0.0;   ///< share of sample points with a model point within 0.1 m at the end
   Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();  ///< (x, y, yaw) of T_model_sample, from the residual
+  /// The same, robust to residuals that are not independent: a cluster-robust (sandwich)
+  /// estimate with the pairs grouped by the sample point's bearing. A front-end's errors are
+  /// shared by neighbouring points (one wall's range bias, a lobe's sub-pixel placement), so
+  /// sigma^2 (J^T J)^-1 above, which treats every pair as an independent measurement, is
+  /// smaller than the error the fit actually makes. Never smaller than `covariance`.
+  Eigen::Matrix3d robust_covariance = Eigen::Matrix3d::Zero();
 };
 
 /// A Gaussian prior on the registered position (an odometry prediction): where the pairs do
