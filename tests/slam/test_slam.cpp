@@ -123,3 +123,37 @@ TEST_CASE("SLAM without odometry (thesis sec. 5.2) tracks a lap in a well-constr
   CHECK(errors.slam_max_m < 0.05);
   CHECK(errors.integrated >= static_cast<int>(0.9 * path.size()));
 }
+
+TEST_CASE("SLAM: the published covariance carries the previous pose's and adds each registration's",
+          "[slam][covariance]") {
+  // The map each frame registers against was built from the frames before it: the published
+  // covariance is the previous one carried to this pose (its heading variance swinging into
+  // the position by the lever arm between the two poses) plus this registration's robust one,
+  // so over a run it grows; a frame without a registration adds its odometry step's instead.
+  Slam slam;
+  const auto walls = omnislam::test::l_room();
+  std::mt19937_64 rng(9);
+  Eigen::Matrix3d previous = Eigen::Matrix3d::Zero();
+  Eigen::Isometry2d previous_pose = Eigen::Isometry2d::Identity();
+  for (int i = 0; i < 8; ++i) {
+    const Eigen::Isometry2d truth = pose(0.1 * i, 0.02 * i, 0.01 * i);
+    const auto estimate = slam.process(omnislam::test::scan_from(walls, truth, rng), truth);
+    if (i > 0) {
+      REQUIRE(estimate.integrated);
+      const Eigen::Vector2d lever = estimate.T_map_base.translation() - previous_pose.translation();
+      Eigen::Matrix3d F = Eigen::Matrix3d::Identity();
+      F(0, 2) = -lever.y();
+      F(1, 2) = lever.x();
+      const Eigen::Matrix3d expected = F * previous * F.transpose() + estimate.registration.robust_covariance;
+      INFO("frame " << i << " covariance\n" << estimate.covariance << "\nexpected\n" << expected);
+      CHECK(estimate.covariance.isApprox(expected, 1e-9));
+      CHECK(estimate.covariance.trace() > previous.trace());
+    }
+    previous = estimate.covariance;
+    previous_pose = estimate.T_map_base;
+  }
+  // Too few points: no registration, the odometry step's uncertainty is added.
+  const auto blind = slam.process({{1.0, 0.0}}, pose(0.9, 0.16, 0.08));
+  CHECK_FALSE(blind.integrated);
+  CHECK(blind.covariance(0, 0) > previous(0, 0));
+}
