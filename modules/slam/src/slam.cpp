@@ -3,6 +3,8 @@
 
 #include <cmath>
 #include <numbers>
+#include <stdexcept>
+#include <string>
 #include <utility>
 
 namespace omnislam::slam {
@@ -143,13 +145,21 @@ FrameEstimate Slam::register_scan(const Points2 &scan_base, const Eigen::Isometr
 }
 
 void Slam::resume(std::vector<MapPoint> points, int integrations, const Eigen::Isometry2d &T_map_base,
-                  const Eigen::Matrix3d &covariance, const std::optional<Eigen::Isometry2d> &T_odom_base) {
-  if (config_.loop_closure.enabled) {
-    // The graph's corrections move what is added to it, not this.
-    restored_points_ = std::make_shared<const std::vector<MapPoint>>(points);
-    restored_integrations_ = integrations;
+                  const Eigen::Matrix3d &covariance, const std::optional<Eigen::Isometry2d> &T_odom_base,
+                  std::optional<ResumedGraph> graph) {
+  const bool continue_graph = config_.loop_closure.enabled && graph;
+  restored_points_.reset();
+  restored_integrations_ = 0;
+  if (continue_graph) {
+    resume_graph(*graph, integrations);
+  } else {
+    if (config_.loop_closure.enabled) {
+      // The graph's corrections move what is added to it, not this.
+      restored_points_ = std::make_shared<const std::vector<MapPoint>>(points);
+      restored_integrations_ = integrations;
+    }
+    keyframes_ = KeyframeGraph(config_.loop_closure.keyframes);
   }
-  keyframes_ = KeyframeGraph(config_.loop_closure.keyframes);
   pending_loop_.reset();
   last_loop_.reset();
   search_due_ = false;
@@ -165,6 +175,23 @@ void Slam::resume(std::vector<MapPoint> points, int integrations, const Eigen::I
   recent_scans_map_.assign(1, map_.index().points());
   relaxation_percent_ = 0.0;
   previous_failed_ = false;
+}
+
+void Slam::resume_graph(const ResumedGraph &graph, int integrations) {
+  // A rebuild integrates the graph's scans instead of the restored points: they must be the same.
+  if (graph.state.integrations() != static_cast<std::size_t>(integrations)) {
+    throw std::invalid_argument("Slam::resume: the keyframe graph holds " +
+                                std::to_string(graph.state.integrations()) + " integrated scans, the map " +
+                                std::to_string(integrations));
+  }
+  keyframes_ = KeyframeGraph(config_.loop_closure.keyframes, graph.state, graph.chained);
+}
+
+std::optional<KeyframeGraphState> Slam::graph_state() const {
+  if (!config_.loop_closure.enabled || restored_points_ ||
+      keyframes_.integrations() != static_cast<std::size_t>(map_.integrations()))
+    return std::nullopt;
+  return keyframes_.state();
 }
 
 void Slam::set_pose(const Eigen::Isometry2d &T_map_base, const Eigen::Matrix3d &covariance) {
