@@ -166,4 +166,6 @@ TEST_CASE("resume without a graph keeps today's fixed base; a graph that is not 
   CHECK_THROWS_AS(refused.resume(first.map().points(), first.map().integrations() - 1, before.last_pose,
                                  before.last_covariance, {}, ResumedGraph{*first.graph_state(), true}),
                   std::invalid_argument);
+  CHECK(refused.map().empty());  // left as it was
+  CHECK(refused.keyframes().keyframes().empty());
 }

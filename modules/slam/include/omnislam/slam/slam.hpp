@@ -198,8 +198,8 @@ class Slam {
   /// optimisation and map rebuild). Returns the frame's pose after any correction.
   [[nodiscard]] Eigen::Isometry2d update_graph(const Points2 &scan_base, FrameEstimate &estimate);
   [[nodiscard]] LoopJob make_loop_job() const;
-  /// resume()'s part with a saved graph: checks it matches the map and continues it.
-  void resume_graph(const ResumedGraph &graph, int integrations);
+  /// The graph resume() continues: `graph`, checked to hold the map's `integrations`.
+  [[nodiscard]] KeyframeGraph resumed_graph(const ResumedGraph &graph, int integrations) const;
   /// Applies a job's result to the graph and the map; returns the correction of the live
   /// pose (T_corrected_tracked: identity when no loop was confirmed).
   [[nodiscard]] Eigen::Isometry2d take_result(LoopResult result);
