@@ -2,7 +2,10 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <iterator>
+#include <memory>
+#include <string>
 #include <vector>
 
 #include "omnislam/io/snapshot.hpp"
@@ -60,9 +63,9 @@ TEST_CASE("snapshot: the odometry pose round-trips; version-1 files (without it)
   CHECK_FALSE(omnislam::io::decode_snapshot(omnislam::io::encode_snapshot(without), "none.snap").T_odom_base);
 
   // Version 1: the same bytes without the 32-byte odometry block after map_integrations
-  // (and without version 3's grid section, 8 bytes when there is no grid).
+  // (and without version 3's grid and version 4's graph sections, 8 bytes each when empty).
   std::vector<std::uint8_t> v1 = omnislam::io::encode_snapshot(written);
-  v1.resize(v1.size() - 8);
+  v1.resize(v1.size() - 16);
   const std::size_t odometry_at = 24 + 8 + 4 * 8 + 9 * 8 + 5 * 8 + 8;
   v1.erase(v1.begin() + static_cast<std::ptrdiff_t>(odometry_at),
            v1.begin() + static_cast<std::ptrdiff_t>(odometry_at + 32));
@@ -80,8 +83,9 @@ TEST_CASE("snapshot: written atomically and read back exactly", "[io][snapshot]"
   const fs::path dir = scratch("roundtrip");
   const Snapshot written = example();
   omnislam::io::write_snapshot(dir / "state.snap", written);
-  // 24-byte header + 200-byte fixed payload + 24 bytes per point + has_grid 0; no temporary left over.
-  CHECK(fs::file_size(dir / "state.snap") == 24 + 200 + 24 * 50 + 8);
+  // 24-byte header + 200-byte fixed payload + 24 bytes per point + has_grid 0 + has_graph 0;
+  // no temporary left over.
+  CHECK(fs::file_size(dir / "state.snap") == 24 + 200 + 24 * 50 + 8 + 8);
   CHECK(std::distance(fs::directory_iterator(dir), fs::directory_iterator()) == 1);
 
   const Snapshot read = omnislam::io::read_snapshot(dir / "state.snap");
@@ -132,7 +136,7 @@ TEST_CASE("snapshot: truncation, bit flips, other versions and bad values are re
   }
   const std::vector<std::uint8_t> header_only(good.begin(), good.begin() + 30);
   CHECK_THROWS_WITH(omnislam::io::decode_snapshot(header_only, "cut.snap"),
-                    Catch::Contains("cut.snap: truncated") && Catch::Contains("1408 payload bytes") &&
+                    Catch::Contains("cut.snap: truncated") && Catch::Contains("1416 payload bytes") &&
                         Catch::Contains("has 6"));
   // A flipped bit anywhere after the magic fails the checksum (or, in the size field, the length).
   for (std::size_t i = 8; i < good.size(); i += 37) {
@@ -154,13 +158,13 @@ TEST_CASE("snapshot: truncation, bit flips, other versions and bad values are re
 
 TEST_CASE("snapshot: a future version or impossible values are named even with a valid checksum",
           "[io][snapshot]") {
-  // A version-4 file (as a newer build would write it) has a valid CRC of its own.
-  std::vector<std::uint8_t> v4 = omnislam::io::encode_snapshot(example());
-  v4[8] = 4;
-  omnislam::test::reseal_snapshot(v4);
+  // A version-5 file (as a newer build would write it) has a valid CRC of its own.
+  std::vector<std::uint8_t> v5 = omnislam::io::encode_snapshot(example());
+  v5[8] = 5;
+  omnislam::test::reseal_snapshot(v5);
   CHECK_THROWS_WITH(
-      omnislam::io::decode_snapshot(v4, "v4.snap"),
-      Catch::Equals("v4.snap: unsupported snapshot version 4 (this build reads versions 1 to 3)"));
+      omnislam::io::decode_snapshot(v5, "v5.snap"),
+      Catch::Equals("v5.snap: unsupported snapshot version 5 (this build reads versions 1 to 4)"));
 
   Snapshot bad = example();
   bad.points[3].hits = 0;
@@ -238,14 +242,14 @@ omnislam::grid::GridImage example_grid() {
 
 }  // namespace
 
-TEST_CASE("snapshot: version 3 carries the occupancy grid; version-2 files (without it) still read",
+TEST_CASE("snapshot: the occupancy grid (since version 3) round-trips; version-3 and -2 files still read",
           "[io][snapshot]") {
   Snapshot written = example();
   written.grid = example_grid();
-  const std::vector<std::uint8_t> v3 = omnislam::io::encode_snapshot(written);
-  CHECK(v3.size() == 24 + 200 + 24 * 50 + 8 + 32 + 21);
-  const Snapshot read = omnislam::io::decode_snapshot(v3, "grid.snap");
-  CHECK(read.version == 3);
+  const std::vector<std::uint8_t> v4 = omnislam::io::encode_snapshot(written);
+  CHECK(v4.size() == 24 + 200 + 24 * 50 + 8 + 32 + 21 + 8);
+  const Snapshot read = omnislam::io::decode_snapshot(v4, "grid.snap");
+  CHECK(read.version == 4);
   REQUIRE(read.grid);
   CHECK(read.grid->width == 7);
   CHECK(read.grid->height == 3);
@@ -254,9 +258,21 @@ TEST_CASE("snapshot: version 3 carries the occupancy grid; version-2 files (with
   CHECK(read.grid->cells == written.grid->cells);
   CHECK(read.points.size() == 50);
 
+  // Version 3: version 4 without the graph section (has_graph 0: 8 bytes), still read.
+  std::vector<std::uint8_t> v3 = v4;
+  v3.resize(v3.size() - 8);
+  v3[8] = 3;
+  omnislam::test::reseal_snapshot(v3);
+  const Snapshot three = omnislam::io::decode_snapshot(v3, "v3.snap");
+  CHECK(three.version == 3);
+  REQUIRE(three.grid);
+  CHECK(three.grid->cells == written.grid->cells);
+  CHECK(three.points.size() == 50);
+  CHECK_FALSE(three.graph);
+
   // Version 2: version 3 without the grid section.
   std::vector<std::uint8_t> v2 = omnislam::io::encode_snapshot(example());
-  v2.resize(v2.size() - 8);
+  v2.resize(v2.size() - 16);
   v2[8] = 2;
   omnislam::test::reseal_snapshot(v2);
   const Snapshot old = omnislam::io::decode_snapshot(v2, "v2.snap");
@@ -277,8 +293,171 @@ TEST_CASE("snapshot: version 3 carries the occupancy grid; version-2 files (with
       omnislam::io::decode_snapshot(omnislam::io::encode_snapshot(bad), "short.snap"),
       Catch::Contains("short.snap: the occupancy grid announces 21 cells, the file holds 20 bytes"));
   // Every truncation of a file with a grid is caught too.
-  for (std::size_t length = v3.size() - 60; length < v3.size(); ++length) {
-    std::vector<std::uint8_t> cut(v3.begin(), v3.begin() + static_cast<long>(length));
+  for (std::size_t length = v4.size() - 60; length < v4.size(); ++length) {
+    std::vector<std::uint8_t> cut(v4.begin(), v4.begin() + static_cast<long>(length));
+    omnislam::test::reseal_snapshot(cut);
+    CHECK_THROWS_AS(omnislam::io::decode_snapshot(cut, "cut.snap"), SnapshotError);
+  }
+}
+
+namespace {
+
+using omnislam::slam::KeyframeGraphState;
+
+// Three keyframes of 40 scans each (120 integrations, as example()'s map), integrated
+// keyframe after keyframe; sequential edges 0-1 and 1-2 and a loop edge 0-2.
+KeyframeGraphState example_graph() {
+  KeyframeGraphState g;
+  for (int k = 0; k < 3; ++k) {
+    KeyframeGraphState::SavedKeyframe keyframe{{0.5 * k, 0.1 * k, 0.3 * k - 0.1}, 0.6 * k, {}};
+    for (int scan = 0; scan < 40; ++scan) {
+      keyframe.scans_keyframe.push_back(std::make_shared<const omnislam::slam::Points2>(
+          omnislam::slam::Points2{{1.0 + k, 0.01 * scan}, {-0.5, 2.0 - k}, {0.125 * scan, -1.0 / 3.0}}));
+      g.integration_order.emplace_back(k, scan);
+    }
+    g.keyframes.push_back(std::move(keyframe));
+  }
+  Eigen::Matrix3d information;
+  information << 1e4, 10, 0, 10, 2e4, 5, 0, 5, 3e5;
+  g.edges.push_back({0, 1, {0.5, 0.1, 0.3}, information, false});
+  g.edges.push_back({1, 2, {0.49, 0.11, 0.31}, information, false});
+  g.edges.push_back({0, 2, {1.0, 0.2, 0.6}, 0.5 * information, true});
+  g.path_m = 1.4;
+  g.last_frame = {1.1, 0.25, 0.55};
+  return g;
+}
+
+Snapshot example_with_graph() {
+  Snapshot s = example();
+  s.graph = example_graph();
+  return s;
+}
+
+bool same_pose(const omnislam::slam::PlanarPose &a, const omnislam::slam::PlanarPose &b) {
+  return a.x_m == b.x_m && a.y_m == b.y_m && a.yaw_rad == b.yaw_rad;
+}
+
+// Re-encodes `s` with its graph edited by `edit`: the writer does not check, the reader must.
+std::vector<std::uint8_t> with_graph(const std::function<void(KeyframeGraphState &)> &edit) {
+  Snapshot s = example_with_graph();
+  edit(*s.graph);
+  return omnislam::io::encode_snapshot(s);
+}
+
+void put_u64(std::vector<std::uint8_t> &bytes, std::size_t at, std::uint64_t v) {
+  for (int i = 0; i < 8; ++i)
+    bytes[at + static_cast<std::size_t>(i)] = static_cast<std::uint8_t>(v >> (8 * i));
+}
+
+}  // namespace
+
+TEST_CASE("snapshot: version 4 carries the keyframe graph exactly; re-encoding gives the same bytes",
+          "[io][snapshot]") {
+  Snapshot written = example_with_graph();
+  written.grid = example_grid();
+  const std::vector<std::uint8_t> bytes = omnislam::io::encode_snapshot(written);
+  // The graph section: 8 (has_graph) + 32 + 3 keyframes x (40 + 40 scans x (8 + 3 x 16))
+  // + 8 + 120 x 8 + 8 + 3 x 112.
+  CHECK(bytes.size() ==
+        24 + 200 + 24 * 50 + 8 + 32 + 21 + 8 + 32 + 8 + 3 * (40 + 40 * 56) + 8 + 960 + 8 + 336);
+  const Snapshot read = omnislam::io::decode_snapshot(bytes, "graph.snap");
+  CHECK(read.version == 4);
+  REQUIRE(read.grid);
+  REQUIRE(read.graph);
+  const KeyframeGraphState &want = *written.graph, &got = *read.graph;
+  REQUIRE(got.keyframes.size() == 3);
+  for (std::size_t k = 0; k < 3; ++k) {
+    CHECK(same_pose(got.keyframes[k].T_map_keyframe, want.keyframes[k].T_map_keyframe));
+    CHECK(got.keyframes[k].path_m == want.keyframes[k].path_m);
+    REQUIRE(got.keyframes[k].scans_keyframe.size() == 40);
+    for (std::size_t scan = 0; scan < 40; ++scan)
+      CHECK(*got.keyframes[k].scans_keyframe[scan] == *want.keyframes[k].scans_keyframe[scan]);
+  }
+  CHECK(got.integration_order == want.integration_order);
+  REQUIRE(got.edges.size() == 3);
+  for (std::size_t e = 0; e < 3; ++e) {
+    CHECK(got.edges[e].from == want.edges[e].from);
+    CHECK(got.edges[e].to == want.edges[e].to);
+    CHECK(same_pose(got.edges[e].T_from_to, want.edges[e].T_from_to));
+    CHECK(got.edges[e].information == want.edges[e].information);
+    CHECK(got.edges[e].loop == want.edges[e].loop);
+  }
+  CHECK(got.path_m == 1.4);
+  CHECK(same_pose(got.last_frame, want.last_frame));
+  CHECK(omnislam::io::encode_snapshot(read) == bytes);
+
+  // Without a graph: one u64 0 where the graph would be.
+  const std::vector<std::uint8_t> none = omnislam::io::encode_snapshot(example());
+  CHECK_FALSE(omnislam::io::decode_snapshot(none, "none.snap").graph);
+  CHECK(omnislam::io::encode_snapshot(omnislam::io::decode_snapshot(none, "none.snap")) == none);
+}
+
+TEST_CASE("snapshot: a version-4 keyframe graph that does not hold together is rejected by name",
+          "[io][snapshot]") {
+  using Graph = KeyframeGraphState;
+  const auto rejects = [](const std::vector<std::uint8_t> &bytes, const std::string &message) {
+    CHECK_THROWS_WITH(omnislam::io::decode_snapshot(bytes, "bad.snap"),
+                      Catch::Equals("bad.snap: " + message));
+  };
+  rejects(with_graph([](Graph &g) { g.edges[2].to = 3; }),
+          "keyframe graph: edge 2 joins keyframes 0 and 3 (3 keyframes)");
+  rejects(with_graph([](Graph &g) { g.edges[0].from = 1; }),
+          "keyframe graph: edge 0 joins keyframes 1 and 1 (3 keyframes)");
+  rejects(with_graph([](Graph &g) { g.edges[1].information.setZero(); }),
+          "keyframe graph: edge 1: information is not symmetric positive definite");
+  rejects(with_graph([](Graph &g) { g.edges[1].information(0, 1) = -3.0; }),
+          "keyframe graph: edge 1: information is not symmetric positive definite");
+  rejects(with_graph([](Graph &g) {
+            g.integration_order.back() = {2, 40};
+          }),
+          "keyframe graph: integration 119 names scan 40 of keyframe 2, which does not exist");
+  rejects(with_graph([](Graph &g) {
+            g.integration_order[5] = {0, 4};
+          }),
+          "keyframe graph: integration 5 names scan 4 of keyframe 0, named before");
+  rejects(with_graph([](Graph &g) { g.integration_order.pop_back(); }),
+          "keyframe graph: the integration order names 119 scans, the keyframes hold 120");
+  rejects(with_graph([](Graph &g) {
+            g.integration_order.pop_back();
+            g.keyframes[2].scans_keyframe.pop_back();
+          }),
+          "the keyframe graph holds 119 integrated scans, the map 120");
+  rejects(
+      with_graph([](Graph &g) { g.keyframes[2].path_m = 0.5; }),
+      "keyframe graph: keyframe 2: path_m 0.500000 is not finite or below the previous keyframe's 0.600000");
+  rejects(with_graph([](Graph &g) { g.path_m = 1.0; }),
+          "keyframe graph: path_m 1.000000 is not finite or below the last keyframe's");
+  rejects(with_graph([](Graph &g) {
+            g.keyframes[1].scans_keyframe[7] =
+                std::make_shared<const omnislam::slam::Points2>(omnislam::slam::Points2{{std::nan(""), 0.0}});
+          }),
+          "keyframe 1 scan point x_m is not a finite number");
+  rejects(with_graph([](Graph &g) { g.edges[2].T_from_to.yaw_rad = INFINITY; }),
+          "edge 2 yaw_rad is not a finite number");
+
+  // Flags and counts edited in the bytes (the writer cannot produce them).
+  const std::vector<std::uint8_t> good = omnislam::io::encode_snapshot(example_with_graph());
+  const std::size_t edges_at = good.size() - 3 * 112 - 8;  // the edge count
+  std::vector<std::uint8_t> bytes = good;
+  put_u64(bytes, good.size() - 112 + 8, 2);  // the last edge's loop flag
+  omnislam::test::reseal_snapshot(bytes);
+  rejects(bytes, "keyframe graph edge 2 loop is 2");
+  bytes = good;
+  put_u64(bytes, edges_at, 1000000000000ull);
+  omnislam::test::reseal_snapshot(bytes);
+  rejects(bytes, "the keyframe graph announces 1000000000000 edges, the 336 bytes left cannot hold them");
+  bytes = good;
+  put_u64(bytes, edges_at, 2);
+  omnislam::test::reseal_snapshot(bytes);
+  rejects(bytes, "trailing bytes after the keyframe graph");
+  bytes = omnislam::io::encode_snapshot(example());
+  put_u64(bytes, bytes.size() - 8, 2);  // has_graph
+  omnislam::test::reseal_snapshot(bytes);
+  rejects(bytes, "has_graph is 2");
+  // Every truncation of the graph section, resealed, is caught.
+  const std::size_t graph_at = omnislam::io::encode_snapshot(example()).size() - 8;
+  for (std::size_t length = graph_at; length < good.size(); length += 7) {
+    std::vector<std::uint8_t> cut(good.begin(), good.begin() + static_cast<long>(length));
     omnislam::test::reseal_snapshot(cut);
     CHECK_THROWS_AS(omnislam::io::decode_snapshot(cut, "cut.snap"), SnapshotError);
   }

@@ -179,11 +179,14 @@ def test_kill_9_then_restart_continues_map_and_pose(tmp_path):
     assert captured - 5 - 3 <= frames_saved <= captured, info
     assert points_saved > 200
     assert info_value(info, "odometry") != "none"
+    # The snapshot carries the keyframe graph the map was built from (version 4).
+    keyframes_saved = int(info_value(info, "keyframe graph").split()[0])
+    assert keyframes_saved > 0, info
 
     second = start(write_config(tmp_path / "second.yaml", state=state, out=tmp_path / "second", rate_hz=0))
     log, _ = second.communicate(timeout=120)
     assert second.returncode == 0, log
-    assert f"resumed from {snapshot}: {points_saved} map points, {frames_saved} frames" in log
+    assert f"resumed from {snapshot}: {points_saved} map points, {frames_saved} frames, {keyframes_saved} keyframes" in log
     trajectory = [line.split() for line in (tmp_path / "second" / "trajectory.tum").read_text().splitlines()
                   if not line.startswith("#")]
     assert abs(float(trajectory[0][0]) - (t_saved + 0.1)) < 1e-6  # continues with the next frame
@@ -193,6 +196,8 @@ def test_kill_9_then_restart_continues_map_and_pose(tmp_path):
     assert resumed["final_m"] <= max(bound["final_m"], 0.083)
     final = map_info(snapshot)
     assert int(info_value(final, "frames").split(",")[0]) == 37
+    # The resumed run continued the saved graph: its keyframes are still the first ones.
+    assert int(info_value(final, "keyframe graph").split()[0]) > keyframes_saved, final
 
 
 def test_corrupt_snapshot_is_kept_aside_or_refused(tmp_path):

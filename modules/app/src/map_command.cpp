@@ -1,6 +1,7 @@
 #include "map_command.hpp"
 #include "omnislam/slam/planar_pose.hpp"
 
+#include <algorithm>
 #include <cinttypes>
 #include <cmath>
 #include <cstdio>
@@ -48,6 +49,16 @@ void print_info(const std::filesystem::path &file) {
                 s.grid->height, s.grid->resolution_m, s.grid->origin_m.x(), s.grid->origin_m.y());
   } else {
     std::printf("occupancy grid: none\n");
+  }
+  if (s.graph) {
+    const auto loops =
+        std::count_if(s.graph->edges.begin(), s.graph->edges.end(),
+                      [](const slam::KeyframeGraphState::SavedEdge &edge) { return edge.loop; });
+    std::printf("keyframe graph: %zu keyframes, %zu edges (%td loop), %zu integrated scans, path %.2f m\n",
+                s.graph->keyframes.size(), s.graph->edges.size(), loops, s.graph->integrations(),
+                s.graph->path_m);
+  } else {
+    std::printf("keyframe graph: none\n");
   }
 }
 

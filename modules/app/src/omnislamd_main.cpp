@@ -236,8 +236,9 @@ int run_service(const std::string &config_file) {
     if (frame.map) counts.map_points.store(frame.map->size(), std::memory_order_relaxed);
     last_frame = frame_record(frame);
     if (frame.state_due && snapshots)
-      snapshots->submit(
-          make_snapshot(*last_frame, *frame.map, frame.map_integrations, n, config_hash, occupancy.image()));
+      snapshots->submit(make_snapshot(*last_frame, *frame.map, frame.map_integrations, n, config_hash,
+                                      occupancy.image(),
+                                      frame.graph ? std::optional(*frame.graph) : std::nullopt));
     if (!service.output_dir.empty()) run.frames.push_back(*last_frame);
   };
   sinks.profile = [&](const pipeline::ProfileSnapshot &profile) {
@@ -255,13 +256,13 @@ int run_service(const std::string &config_file) {
         "searching for the pose on the saved map ({} points; persistence.start_pose {}): nothing is "
         "published until one pose is confirmed",
         resumed->points.size(), config.slam.localization_only ? "auto, localization_only" : "search");
-    pipeline.relocalize(resumed->points, resumed->map_integrations);
+    pipeline.relocalize(resumed->points, resumed->map_integrations, {}, {}, resumed->graph);
     status.state = dds::ServiceState::kLocalizing;  // running becomes the publish thread's to say
     status.stamp_s = system_time_s();
     if (publisher) publisher->status(status);
   } else if (resumed) {
     pipeline.resume(resumed->points, resumed->map_integrations, resumed->T_map_base, resumed->covariance,
-                    resumed->T_odom_base);
+                    resumed->T_odom_base, resumed_graph(*resumed));
   }
   const auto initial_pose_counts = std::make_shared<InitialPoseCounts>();
   pipeline::FrameSource source = checked_source(input.source, config.scan.camera, status);
@@ -303,7 +304,7 @@ int run_service(const std::string &config_file) {
     // The final state, written before anything else can fail.
     snapshots->submit(make_snapshot(*last_frame, pipeline.slam().map().points(),
                                     pipeline.slam().map().integrations(), counts.totals, config_hash,
-                                    final_grid));
+                                    final_grid, pipeline.slam().graph_state()));
   }
   if (snapshots) {
     snapshots->finish();

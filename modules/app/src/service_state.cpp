@@ -55,7 +55,7 @@ std::optional<io::Snapshot> resume_state(const io::Config &config, const std::fi
 
 io::Snapshot make_snapshot(const FrameRecord &frame, std::vector<slam::MapPoint> points, int map_integrations,
                            const io::SnapshotCounters &counters, std::uint64_t config_hash,
-                           grid::GridImage grid) {
+                           grid::GridImage grid, std::optional<slam::KeyframeGraphState> graph) {
   io::Snapshot s;
   s.config_hash = config_hash;
   s.t_s = frame.t_s;
@@ -66,7 +66,13 @@ io::Snapshot make_snapshot(const FrameRecord &frame, std::vector<slam::MapPoint>
   s.map_integrations = map_integrations;
   s.points = std::move(points);
   if (grid.width > 0) s.grid = std::move(grid);
+  s.graph = std::move(graph);
   return s;
+}
+
+std::optional<slam::ResumedGraph> resumed_graph(const io::Snapshot &snapshot) {
+  if (!snapshot.graph) return std::nullopt;
+  return slam::ResumedGraph{*snapshot.graph, true};
 }
 
 }  // namespace omnislam::app

@@ -9,6 +9,7 @@
 #include "omnislam/io/config.hpp"
 #include "omnislam/io/snapshot.hpp"
 #include "omnislam/slam/point_map.hpp"
+#include "omnislam/slam/slam.hpp"
 #include "run_record.hpp"
 
 // omnislamd's saved state: where the snapshot lives, resuming from it at start, and the
@@ -33,9 +34,16 @@ class StateError : public std::runtime_error {
                                                        std::uint64_t config_hash);
 
 /// The snapshot after `frame`: its pose, covariance and odometry, with the map as it was
-/// then (points and slam::PointMap::integrations()) and the occupancy grid (none when empty).
+/// then (points and slam::PointMap::integrations()), the occupancy grid (none when empty)
+/// and the keyframe graph (slam::Slam::graph_state; none when it does not describe the map).
 [[nodiscard]] io::Snapshot make_snapshot(const FrameRecord &frame, std::vector<slam::MapPoint> points,
                                          int map_integrations, const io::SnapshotCounters &counters,
-                                         std::uint64_t config_hash, grid::GridImage grid);
+                                         std::uint64_t config_hash, grid::GridImage grid,
+                                         std::optional<slam::KeyframeGraphState> graph);
+
+/// How the service resumes the saved keyframe graph (none in the snapshot: none): chained
+/// to the new keyframes, since the saved pose is taken as is and the tracking continues
+/// from it (slam::ResumedGraph::chained).
+[[nodiscard]] std::optional<slam::ResumedGraph> resumed_graph(const io::Snapshot &snapshot);
 
 }  // namespace omnislam::app

@@ -13,6 +13,7 @@
 #include <fstream>
 #include <iterator>
 #include <limits>
+#include <memory>
 #include <optional>
 #include <string_view>
 #include <system_error>
@@ -26,6 +27,14 @@ constexpr std::size_t kOdometryBytes = 8 + 3 * 8;  // version 2 only
 constexpr std::size_t kFixedPayloadBytesV1 = 8 + 8 * 4 + 8 * 9 + 8 * 5 + 8 + 8;
 constexpr std::size_t kPointBytes = 8 + 8 + 4 + 4;
 constexpr std::size_t kGridHeaderBytes = 4 + 4 + 8 + 8 + 8;  // version 3, when has_grid is 1
+// Version 4's graph section, when has_graph is 1: its fixed fields, and the least bytes
+// each counted item takes (a keyframe without scans, a scan without points, ...).
+constexpr std::size_t kGraphHeaderBytes = 8 + 3 * 8;
+constexpr std::size_t kKeyframeBytes = 4 * 8 + 8;
+constexpr std::size_t kScanBytes = 8;
+constexpr std::size_t kScanPointBytes = 8 + 8;
+constexpr std::size_t kIntegrationBytes = 4 + 4;
+constexpr std::size_t kEdgeBytes = 4 + 4 + 8 + 3 * 8 + 9 * 8;
 
 class ByteWriter {
  public:
@@ -106,8 +115,9 @@ void fsync_directory(const std::filesystem::path &dir) {
   if (status != 0) throw std::runtime_error(system_error("fsync directory", dir));
 }
 
-// The version-3 grid section: u64 has_grid, then (when 1) the trinary grid.
-std::optional<grid::GridImage> decode_grid(ByteReader &in, const std::string &name) {
+// The version-3 grid section: u64 has_grid, then (when 1) the trinary grid, followed by
+// `trailing` more bytes at least (version 4's graph section) or, with 0, nothing.
+std::optional<grid::GridImage> decode_grid(ByteReader &in, const std::string &name, std::size_t trailing) {
   const std::uint64_t has_grid = in.u64();
   if (has_grid > 1) throw SnapshotError(name + ": has_grid is " + std::to_string(has_grid));
   if (has_grid == 0) return std::nullopt;
@@ -123,9 +133,10 @@ std::optional<grid::GridImage> decode_grid(ByteReader &in, const std::string &na
                         std::to_string(g.height) + " cells at " + std::to_string(g.resolution_m) + " m");
   }
   const std::uint64_t cells = static_cast<std::uint64_t>(g.width) * static_cast<std::uint64_t>(g.height);
-  if (in.remaining() != cells) {
+  const std::uint64_t available = in.remaining() >= trailing ? in.remaining() - trailing : 0;
+  if (trailing == 0 ? available != cells : available < cells) {
     throw SnapshotError(name + ": the occupancy grid announces " + std::to_string(cells) +
-                        " cells, the file holds " + std::to_string(in.remaining()) + " bytes");
+                        " cells, the file holds " + std::to_string(available) + " bytes");
   }
   g.cells.resize(cells);
   for (std::uint64_t i = 0; i < cells; ++i) {
@@ -136,6 +147,141 @@ std::optional<grid::GridImage> decode_grid(ByteReader &in, const std::string &na
     }
   }
   return g;
+}
+
+void encode_pose(ByteWriter &out, const slam::PlanarPose &pose) {
+  out.f64(pose.x_m);
+  out.f64(pose.y_m);
+  out.f64(pose.yaw_rad);
+}
+
+// The version-4 graph section: u64 has_graph, then (when 1) the keyframe graph.
+void encode_graph(ByteWriter &out, const std::optional<slam::KeyframeGraphState> &graph) {
+  out.u64(graph ? 1 : 0);
+  if (!graph) return;
+  out.f64(graph->path_m);
+  encode_pose(out, graph->last_frame);
+  out.u64(graph->keyframes.size());
+  for (const slam::KeyframeGraphState::SavedKeyframe &keyframe : graph->keyframes) {
+    encode_pose(out, keyframe.T_map_keyframe);
+    out.f64(keyframe.path_m);
+    out.u64(keyframe.scans_keyframe.size());
+    for (const auto &scan : keyframe.scans_keyframe) {
+      out.u64(scan->size());
+      for (const slam::Point2 &p : *scan) {
+        out.f64(p.x());
+        out.f64(p.y());
+      }
+    }
+  }
+  out.u64(graph->integration_order.size());
+  for (const auto &[keyframe, scan] : graph->integration_order) {
+    out.u32(static_cast<std::uint32_t>(keyframe));
+    out.u32(static_cast<std::uint32_t>(scan));
+  }
+  out.u64(graph->edges.size());
+  for (const slam::KeyframeGraphState::SavedEdge &edge : graph->edges) {
+    out.u32(static_cast<std::uint32_t>(edge.from));
+    out.u32(static_cast<std::uint32_t>(edge.to));
+    out.u64(edge.loop ? 1 : 0);
+    encode_pose(out, edge.T_from_to);
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 3; ++c) out.f64(edge.information(r, c));
+  }
+}
+
+slam::PlanarPose decode_pose(ByteReader &in, const std::string &what) {
+  slam::PlanarPose pose;
+  pose.x_m = in.f64((what + " x_m").c_str());
+  pose.y_m = in.f64((what + " y_m").c_str());
+  pose.yaw_rad = in.f64((what + " yaw_rad").c_str());
+  return pose;
+}
+
+// A count of items of at least `item_bytes` each, checked against what is left before
+// anything is allocated for them.
+std::size_t decode_count(ByteReader &in, const std::string &name, const std::string &what,
+                         std::size_t item_bytes) {
+  const std::uint64_t count = in.u64();
+  if (count > in.remaining() / item_bytes) {
+    throw SnapshotError(name + ": the keyframe graph announces " + std::to_string(count) + " " + what +
+                        ", the " + std::to_string(in.remaining()) + " bytes left cannot hold them");
+  }
+  return static_cast<std::size_t>(count);
+}
+
+int decode_index(ByteReader &in, const std::string &name, const std::string &what) {
+  const std::uint32_t index = in.u32();
+  if (index > static_cast<std::uint32_t>(std::numeric_limits<int>::max()))
+    throw SnapshotError(name + ": keyframe graph " + what + " " + std::to_string(index) + " out of range");
+  return static_cast<int>(index);
+}
+
+slam::KeyframeGraphState::SavedKeyframe decode_keyframe(ByteReader &in, const std::string &name,
+                                                        std::size_t k) {
+  const std::string which = "keyframe " + std::to_string(k);
+  slam::KeyframeGraphState::SavedKeyframe keyframe;
+  keyframe.T_map_keyframe = decode_pose(in, which);
+  keyframe.path_m = in.f64((which + " path_m").c_str());
+  const std::size_t scans = decode_count(in, name, "scans of " + which, kScanBytes);
+  const std::string x_field = which + " scan point x_m", y_field = which + " scan point y_m";
+  for (std::size_t i = 0; i < scans; ++i) {
+    const std::size_t points =
+        decode_count(in, name, "points of " + which + " scan " + std::to_string(i), kScanPointBytes);
+    auto scan = std::make_shared<slam::Points2>();
+    scan->reserve(points);
+    for (std::size_t j = 0; j < points; ++j) {
+      const double x = in.f64(x_field.c_str());
+      scan->emplace_back(x, in.f64(y_field.c_str()));
+    }
+    keyframe.scans_keyframe.push_back(std::move(scan));
+  }
+  return keyframe;
+}
+
+slam::KeyframeGraphState::SavedEdge decode_edge(ByteReader &in, const std::string &name, std::size_t e) {
+  const std::string which = "edge " + std::to_string(e);
+  slam::KeyframeGraphState::SavedEdge edge;
+  edge.from = decode_index(in, name, which + " from");
+  edge.to = decode_index(in, name, which + " to");
+  const std::uint64_t loop = in.u64();
+  if (loop > 1) throw SnapshotError(name + ": keyframe graph " + which + " loop is " + std::to_string(loop));
+  edge.loop = loop == 1;
+  edge.T_from_to = decode_pose(in, which);
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) edge.information(r, c) = in.f64((which + " information").c_str());
+  return edge;
+}
+
+// The version-4 graph section, checked as a whole once read (indices in range, every scan
+// integrated once, ...) and against the map it must describe.
+std::optional<slam::KeyframeGraphState> decode_graph(ByteReader &in, const std::string &name,
+                                                     int map_integrations) {
+  const std::uint64_t has_graph = in.u64();
+  if (has_graph > 1) throw SnapshotError(name + ": has_graph is " + std::to_string(has_graph));
+  if (has_graph == 0) return std::nullopt;
+  if (in.remaining() < kGraphHeaderBytes) throw SnapshotError(name + ": truncated keyframe graph");
+  slam::KeyframeGraphState graph;
+  graph.path_m = in.f64("keyframe graph path_m");
+  graph.last_frame = decode_pose(in, "keyframe graph last frame");
+  const std::size_t keyframes = decode_count(in, name, "keyframes", kKeyframeBytes);
+  for (std::size_t k = 0; k < keyframes; ++k) graph.keyframes.push_back(decode_keyframe(in, name, k));
+  const std::size_t integrations = decode_count(in, name, "integrations", kIntegrationBytes);
+  graph.integration_order.reserve(integrations);
+  for (std::size_t i = 0; i < integrations; ++i) {
+    const int keyframe = decode_index(in, name, "integration keyframe");
+    graph.integration_order.emplace_back(keyframe, decode_index(in, name, "integration scan"));
+  }
+  const std::size_t edges = decode_count(in, name, "edges", kEdgeBytes);
+  graph.edges.reserve(edges);
+  for (std::size_t e = 0; e < edges; ++e) graph.edges.push_back(decode_edge(in, name, e));
+  if (const std::string error = slam::keyframe_graph_state_error(graph); !error.empty())
+    throw SnapshotError(name + ": keyframe graph: " + error);
+  if (graph.integrations() != static_cast<std::size_t>(map_integrations)) {
+    throw SnapshotError(name + ": the keyframe graph holds " + std::to_string(graph.integrations()) +
+                        " integrated scans, the map " + std::to_string(map_integrations));
+  }
+  return graph;
 }
 
 }  // namespace
@@ -176,6 +322,7 @@ std::vector<std::uint8_t> encode_snapshot(const Snapshot &snapshot) {
     payload.f64(g.origin_m.y());
     for (const std::int8_t cell : g.cells) payload.i8(cell);
   }
+  encode_graph(payload, snapshot.graph);
 
   ByteWriter header;
   header.bytes.assign(kMagic.begin(), kMagic.end());
@@ -239,14 +386,17 @@ Snapshot decode_snapshot(std::span<const std::uint8_t> bytes, const std::string 
     if (has_odometry == 1) s.T_odom_base = slam::planar_pose(ox, oy, oyaw);
   }
   const std::uint64_t count = in.u64();
-  // Version 3 ends with the grid section (at least its u64 has_grid); earlier ones with the points.
+  // Version 3 ends with the grid section (at least its u64 has_grid), version 4 with the
+  // grid and graph sections (at least their two u64 flags); earlier ones with the points.
+  const std::uint64_t sections_bytes = version >= 4 ? 16 : (version == 3 ? 8 : 0);
   const std::uint64_t point_bytes = payload.size() - fixed_bytes;
   const std::uint64_t announced = count <= point_bytes / kPointBytes ? count * kPointBytes : point_bytes + 1;
-  const bool points_fit = version >= 3 ? announced + 8 <= point_bytes
+  const bool points_fit = version >= 3 ? announced + sections_bytes <= point_bytes
                                        : point_bytes % kPointBytes == 0 && announced == point_bytes;
   if (!points_fit) {
     throw SnapshotError(name + ": announces " + std::to_string(count) + " map points but holds " +
-                        std::to_string(point_bytes) + " bytes of points" + (version >= 3 ? " and grid" : ""));
+                        std::to_string(point_bytes) + " bytes of points" +
+                        (version >= 4 ? ", grid and graph" : (version == 3 ? " and grid" : "")));
   }
   s.points.reserve(count);
   for (std::uint64_t i = 0; i < count; ++i) {
@@ -262,8 +412,12 @@ Snapshot decode_snapshot(std::span<const std::uint8_t> bytes, const std::string 
     }
     s.points.push_back(p);
   }
-  if (version >= 3) s.grid = decode_grid(in, name);
-  if (in.remaining() != 0) throw SnapshotError(name + ": trailing bytes after the occupancy grid");
+  if (version >= 3) s.grid = decode_grid(in, name, version >= 4 ? 8 : 0);
+  if (version >= 4) s.graph = decode_graph(in, name, s.map_integrations);
+  if (in.remaining() != 0) {
+    throw SnapshotError(name + ": trailing bytes after the " +
+                        (version >= 4 ? "keyframe graph" : "occupancy grid"));
+  }
   return s;
 }
 
@@ -325,8 +479,11 @@ ResumeResult resume_from_snapshot(const std::filesystem::path &file, CorruptSnap
   }
   try {
     result.snapshot = read_snapshot(file);
-    result.message = "resumed from " + file.string() + ": " + std::to_string(result.snapshot->points.size()) +
-                     " map points, " + std::to_string(result.snapshot->counters.frames) + " frames";
+    result.message =
+        "resumed from " + file.string() + ": " + std::to_string(result.snapshot->points.size()) +
+        " map points, " + std::to_string(result.snapshot->counters.frames) + " frames, " +
+        (result.snapshot->graph ? std::to_string(result.snapshot->graph->keyframes.size()) + " keyframes"
+                                : std::string("no keyframe graph"));
   } catch (const SnapshotError &corrupt) {
     if (policy == CorruptSnapshotPolicy::kRefuse) {
       throw SnapshotError(std::string(corrupt.what()) +

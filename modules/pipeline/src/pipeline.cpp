@@ -76,13 +76,15 @@ Pipeline::~Pipeline() {
 
 void Pipeline::resume(std::vector<slam::MapPoint> points, int integrations,
                       const Eigen::Isometry2d &T_map_base, const Eigen::Matrix3d &covariance,
-                      const std::optional<Eigen::Isometry2d> &T_odom_base) {
+                      const std::optional<Eigen::Isometry2d> &T_odom_base,
+                      std::optional<slam::ResumedGraph> graph) {
   if (started_) throw std::logic_error("Pipeline::resume after start");
-  slam_.resume(std::move(points), integrations, T_map_base, covariance, T_odom_base);
+  slam_.resume(std::move(points), integrations, T_map_base, covariance, T_odom_base, std::move(graph));
 }
 
 void Pipeline::relocalize(std::vector<slam::MapPoint> points, int integrations,
-                          const slam::RelocalizerConfig &config, std::optional<slam::SearchWindow> window) {
+                          const slam::RelocalizerConfig &config, std::optional<slam::SearchWindow> window,
+                          std::optional<slam::KeyframeGraphState> graph) {
   if (started_) throw std::logic_error("Pipeline::relocalize after start");
   slam::Points2 positions;
   positions.reserve(points.size());
@@ -91,6 +93,7 @@ void Pipeline::relocalize(std::vector<slam::MapPoint> points, int integrations,
   relocalizer_config_ = config;
   saved_points_ = std::move(points);
   saved_integrations_ = integrations;
+  saved_graph_ = std::move(graph);
   window_ = window;
 }
 
@@ -286,8 +289,10 @@ void Pipeline::relocalize_frame(Frame &frame, const std::optional<Eigen::Isometr
   if (!frame.localized) return;
   frame.estimate.T_map_base = found.T_map_base;
   frame.estimate.covariance = found.covariance;
-  slam_.resume(std::move(saved_points_), saved_integrations_, found.T_map_base, found.covariance,
-               T_odom_base);
+  std::optional<slam::ResumedGraph> graph;
+  if (saved_graph_) graph = slam::ResumedGraph{std::move(*saved_graph_), false};
+  slam_.resume(std::move(saved_points_), saved_integrations_, found.T_map_base, found.covariance, T_odom_base,
+               std::move(graph));
   relocalizer_.reset();
 }
 
@@ -336,6 +341,8 @@ void Pipeline::slam_loop() {
         now - last_state >= std::chrono::duration<double>(config_.state_period_s)) {
       if (!frame->map) frame->map = std::make_shared<const std::vector<slam::MapPoint>>(slam_.map().points());
       frame->state_due = true;
+      if (std::optional<slam::KeyframeGraphState> graph = slam_.graph_state())
+        frame->graph = std::make_shared<const slam::KeyframeGraphState>(std::move(*graph));
       last_state = now;
     }
     if (frame->map) frame->map_integrations = slam_.map().integrations();

@@ -1,9 +1,13 @@
 #include "omnislam/slam/keyframe_graph.hpp"
 
+#include <Eigen/Cholesky>
 #include <algorithm>
 #include <cmath>
 #include <memory>
+#include <stdexcept>
+#include <string>
 #include <utility>
+#include <vector>
 
 #include "omnislam/slam/planar_pose.hpp"
 
@@ -17,7 +21,126 @@ Eigen::Matrix3d in_frame(const Eigen::Matrix3d &covariance_map, const Eigen::Mat
   return rotate * covariance_map * rotate.transpose();
 }
 
+PlanarPose planar_of(const Eigen::Isometry2d &T) {
+  return {T.translation().x(), T.translation().y(), yaw_rad_of(T)};
+}
+
+Eigen::Isometry2d isometry_of(const PlanarPose &pose) {
+  return planar_pose(pose.x_m, pose.y_m, pose.yaw_rad);
+}
+
+bool finite(const PlanarPose &pose) {
+  return std::isfinite(pose.x_m) && std::isfinite(pose.y_m) && std::isfinite(pose.yaw_rad);
+}
+
+// A pose graph edge's information must whiten its residual (a Cholesky factor exists):
+// symmetric (up to the rounding of a covariance's inverse) and positive definite.
+bool usable_information(const Eigen::Matrix3d &information) {
+  if (!information.allFinite()) return false;
+  if ((information - information.transpose()).cwiseAbs().maxCoeff() >
+      1e-9 * information.cwiseAbs().maxCoeff())
+    return false;
+  return Eigen::LLT<Eigen::Matrix3d>(information).info() == Eigen::Success;
+}
+
+std::string keyframe_error(const KeyframeGraphState::SavedKeyframe &keyframe, std::size_t k,
+                           double previous_path_m) {
+  const std::string which = "keyframe " + std::to_string(k);
+  if (!finite(keyframe.T_map_keyframe)) return which + ": pose is not finite";
+  if (!std::isfinite(keyframe.path_m) || keyframe.path_m < previous_path_m)
+    return which + ": path_m " + std::to_string(keyframe.path_m) +
+           " is not finite or below the previous "
+           "keyframe's " +
+           std::to_string(previous_path_m);
+  for (std::size_t i = 0; i < keyframe.scans_keyframe.size(); ++i) {
+    const std::shared_ptr<const Points2> &scan = keyframe.scans_keyframe[i];
+    if (!scan) return which + ": scan " + std::to_string(i) + " is missing";
+    for (const Point2 &p : *scan)
+      if (!p.allFinite()) return which + ": scan " + std::to_string(i) + " has a non-finite point";
+  }
+  return {};
+}
+
+std::string edge_error(const KeyframeGraphState::SavedEdge &edge, std::size_t e, std::size_t keyframes) {
+  const std::string which = "edge " + std::to_string(e);
+  const auto in_range = [&](int node) { return node >= 0 && static_cast<std::size_t>(node) < keyframes; };
+  if (!in_range(edge.from) || !in_range(edge.to) || edge.from == edge.to) {
+    return which + " joins keyframes " + std::to_string(edge.from) + " and " + std::to_string(edge.to) +
+           " (" + std::to_string(keyframes) + " keyframes)";
+  }
+  if (!finite(edge.T_from_to)) return which + ": relative pose is not finite";
+  if (!usable_information(edge.information))
+    return which + ": information is not symmetric positive definite";
+  return {};
+}
+
+// Every stored scan named once by the integration order, so a rebuilt map holds each once.
+std::string integration_order_error(const KeyframeGraphState &state) {
+  std::vector<std::vector<bool>> seen;
+  std::size_t scans = 0;
+  for (const auto &keyframe : state.keyframes) {
+    seen.emplace_back(keyframe.scans_keyframe.size(), false);
+    scans += keyframe.scans_keyframe.size();
+  }
+  if (state.integration_order.size() != scans) {
+    return "the integration order names " + std::to_string(state.integration_order.size()) +
+           " scans, the keyframes hold " + std::to_string(scans);
+  }
+  for (std::size_t i = 0; i < state.integration_order.size(); ++i) {
+    const auto [k, scan] = state.integration_order[i];
+    const bool valid = k >= 0 && static_cast<std::size_t>(k) < seen.size() && scan >= 0 &&
+                       static_cast<std::size_t>(scan) < seen[static_cast<std::size_t>(k)].size();
+    if (!valid || seen[static_cast<std::size_t>(k)][static_cast<std::size_t>(scan)]) {
+      return "integration " + std::to_string(i) + " names scan " + std::to_string(scan) + " of keyframe " +
+             std::to_string(k) + (valid ? ", named before" : ", which does not exist");
+    }
+    seen[static_cast<std::size_t>(k)][static_cast<std::size_t>(scan)] = true;
+  }
+  return {};
+}
+
 }  // namespace
+
+std::string keyframe_graph_state_error(const KeyframeGraphState &state) {
+  double path_m = 0.0;
+  for (std::size_t k = 0; k < state.keyframes.size(); ++k) {
+    if (std::string error = keyframe_error(state.keyframes[k], k, path_m); !error.empty()) return error;
+    path_m = state.keyframes[k].path_m;
+  }
+  for (std::size_t e = 0; e < state.edges.size(); ++e)
+    if (std::string error = edge_error(state.edges[e], e, state.keyframes.size()); !error.empty())
+      return error;
+  if (std::string error = integration_order_error(state); !error.empty()) return error;
+  if (!std::isfinite(state.path_m) || state.path_m < path_m)
+    return "path_m " + std::to_string(state.path_m) + " is not finite or below the last keyframe's";
+  if (!finite(state.last_frame)) return "the last frame's pose is not finite";
+  return {};
+}
+
+KeyframeGraph::KeyframeGraph(KeyframeConfig config, const KeyframeGraphState &state, bool chained)
+    : config_(config), path_m_(state.path_m), last_frame_(isometry_of(state.last_frame)), chained_(chained) {
+  if (std::string error = keyframe_graph_state_error(state); !error.empty())
+    throw std::invalid_argument("keyframe graph state: " + error);
+  for (const KeyframeGraphState::SavedKeyframe &saved : state.keyframes) {
+    keyframes_.push_back({isometry_of(saved.T_map_keyframe), saved.path_m, saved.scans_keyframe});
+    graph_.add_node(keyframes_.back().T_map_keyframe);
+  }
+  for (const KeyframeGraphState::SavedEdge &edge : state.edges)
+    graph_.add_edge({edge.from, edge.to, isometry_of(edge.T_from_to), edge.information, edge.loop});
+  integration_order_ = state.integration_order;
+}
+
+KeyframeGraphState KeyframeGraph::state() const {
+  KeyframeGraphState state;
+  for (const Keyframe &keyframe : keyframes_)
+    state.keyframes.push_back({planar_of(keyframe.T_map_keyframe), keyframe.path_m, keyframe.scans_keyframe});
+  for (const PoseGraphEdge &edge : graph_.edges())
+    state.edges.push_back({edge.from, edge.to, planar_of(edge.T_from_to), edge.information, edge.loop});
+  state.integration_order = integration_order_;
+  state.path_m = path_m_;
+  state.last_frame = planar_of(last_frame_);
+  return state;
+}
 
 KeyframeGraph::FrameAnchor KeyframeGraph::anchor(const Eigen::Isometry2d &T_map_base) const {
   if (keyframes_.empty()) return {-1, T_map_base};
@@ -34,7 +157,9 @@ bool KeyframeGraph::add_integrated(const Points2 &scan_base, const Eigen::Isomet
                                    const Eigen::Matrix3d &registration_covariance) {
   if (!keyframes_.empty()) path_m_ += (T_map_base.translation() - last_frame_.translation()).norm();
   last_frame_ = T_map_base;
-  bool is_keyframe = keyframes_.empty();
+  // After a resume that does not continue the saved tracking, the first integrated frame
+  // starts a keyframe of its own: its scan belongs to none of the saved keyframes.
+  bool is_keyframe = keyframes_.empty() || !chained_;
   if (!is_keyframe) {
     const Eigen::Isometry2d step = keyframes_.back().T_map_keyframe.inverse() * T_map_base;
     is_keyframe = step.translation().norm() >= config_.keyframe_distance_m ||
@@ -42,7 +167,7 @@ bool KeyframeGraph::add_integrated(const Points2 &scan_base, const Eigen::Isomet
   }
   if (is_keyframe) {
     const int node = graph_.add_node(T_map_base);
-    if (node > 0) {
+    if (node > 0 && chained_) {
       // The sequential edge: the relative pose the tracking produced, with the
       // registration's covariance plus the drift the tracking can accumulate over it.
       const Keyframe &previous = keyframes_.back();
@@ -58,6 +183,7 @@ bool KeyframeGraph::add_integrated(const Points2 &scan_base, const Eigen::Isomet
       graph_.add_edge({node - 1, node, T_previous_current, covariance.inverse(), false});
     }
     keyframes_.push_back({T_map_base, path_m_, {}});
+    chained_ = true;
   }
   frames_.push_back(anchor(T_map_base));
   keyframes_.back().scans_keyframe.push_back(
@@ -125,6 +251,7 @@ KeyframeGraph KeyframeGraph::without_trajectory() const {
   copy.graph_ = graph_;
   copy.path_m_ = path_m_;
   copy.last_frame_ = last_frame_;
+  copy.chained_ = chained_;
   return copy;
 }
 

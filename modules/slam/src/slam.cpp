@@ -3,6 +3,8 @@
 
 #include <cmath>
 #include <numbers>
+#include <stdexcept>
+#include <string>
 #include <utility>
 
 namespace omnislam::slam {
@@ -143,13 +145,21 @@ FrameEstimate Slam::register_scan(const Points2 &scan_base, const Eigen::Isometr
 }
 
 void Slam::resume(std::vector<MapPoint> points, int integrations, const Eigen::Isometry2d &T_map_base,
-                  const Eigen::Matrix3d &covariance, const std::optional<Eigen::Isometry2d> &T_odom_base) {
-  if (config_.loop_closure.enabled) {
-    // The graph's corrections move what is added to it, not this.
+                  const Eigen::Matrix3d &covariance, const std::optional<Eigen::Isometry2d> &T_odom_base,
+                  std::optional<ResumedGraph> graph) {
+  // Checked before anything changes: a graph that is not the map's leaves this as it was.
+  const bool continue_graph = config_.loop_closure.enabled && graph;
+  KeyframeGraph keyframes =
+      continue_graph ? resumed_graph(*graph, integrations) : KeyframeGraph(config_.loop_closure.keyframes);
+  // With the saved graph the restored points are its scans, which a rebuild integrates
+  // itself; without it they are a base the graph's corrections do not move.
+  restored_points_.reset();
+  restored_integrations_ = 0;
+  if (config_.loop_closure.enabled && !continue_graph) {
     restored_points_ = std::make_shared<const std::vector<MapPoint>>(points);
     restored_integrations_ = integrations;
   }
-  keyframes_ = KeyframeGraph(config_.loop_closure.keyframes);
+  keyframes_ = std::move(keyframes);
   pending_loop_.reset();
   last_loop_.reset();
   search_due_ = false;
@@ -165,6 +175,25 @@ void Slam::resume(std::vector<MapPoint> points, int integrations, const Eigen::I
   recent_scans_map_.assign(1, map_.index().points());
   relaxation_percent_ = 0.0;
   previous_failed_ = false;
+}
+
+KeyframeGraph Slam::resumed_graph(const ResumedGraph &graph, int integrations) const {
+  // A rebuild integrates the graph's scans instead of the restored points: they must be the same.
+  if (graph.state.integrations() != static_cast<std::size_t>(integrations)) {
+    throw std::invalid_argument("Slam::resume: the keyframe graph holds " +
+                                std::to_string(graph.state.integrations()) + " integrated scans, the map " +
+                                std::to_string(integrations));
+  }
+  return KeyframeGraph(config_.loop_closure.keyframes, graph.state, graph.chained);
+}
+
+std::optional<KeyframeGraphState> Slam::graph_state() const {
+  // Without loop closure no scan is kept; after a resume without a graph the restored points
+  // are in no keyframe. Either way a map rebuilt from the graph would not be this map.
+  if (!config_.loop_closure.enabled || restored_points_ ||
+      keyframes_.integrations() != static_cast<std::size_t>(map_.integrations()))
+    return std::nullopt;
+  return keyframes_.state();
 }
 
 void Slam::set_pose(const Eigen::Isometry2d &T_map_base, const Eigen::Matrix3d &covariance) {

@@ -10,17 +10,18 @@
 #include <vector>
 
 #include "omnislam/grid/occupancy_grid.hpp"
+#include "omnislam/slam/keyframe_graph.hpp"
 #include "omnislam/slam/point_map.hpp"
 
 /// @file
 /// Snapshots of the SLAM state (map, pose, counters, configuration hash) that a service
 /// writes periodically into its state directory and resumes from after a restart.
 ///
-/// File format, version 3 (all integers and doubles little-endian):
+/// File format, version 4 (all integers and doubles little-endian):
 /// ```
 /// offset  size  field
 ///  0       8    magic "OMNISNAP"
-///  8       4    u32 format version (3)
+///  8       4    u32 format version (4)
 /// 12       8    u64 payload size in bytes
 /// 20       4    u32 CRC-32 (zlib) of bytes 8..19 followed by the payload
 /// 24       -    payload: u64 config_hash, f64 t_s, f64 x_m, f64 y_m, f64 yaw_rad,
@@ -30,14 +31,23 @@
 ///               u64 point count, then per point f64 x_m, f64 y_m, i32 hits, i32 first_seen,
 ///               u64 has_grid (0 or 1), and when 1: i32 width, i32 height, f64 resolution_m,
 ///               f64 origin x_m, f64 origin y_m, width x height i8 cells (-1, 0, 100; the
-///               layout of grid::GridImage)
+///               layout of grid::GridImage),
+///               u64 has_graph (0 or 1), and when 1 the keyframe graph
+///               (slam::KeyframeGraphState): f64 path_m, f64 last frame x_m, y_m, yaw_rad,
+///               u64 keyframe count, per keyframe f64 x_m, f64 y_m, f64 yaw_rad, f64 path_m,
+///               u64 scan count, per scan u64 point count and per point f64 x_m, f64 y_m
+///               (keyframe coordinates); u64 integration count, per integration u32
+///               keyframe, u32 scan (within the keyframe); u64 edge count, per edge u32 from,
+///               u32 to, u64 loop (0 or 1), f64 x_m, f64 y_m, f64 yaw_rad (pose of `to` in
+///               `from`), 9 x f64 information (row-major, x y yaw)
 /// ```
-/// Version 2 is version 3 without the grid section, version 1 version 2 without the four
-/// odometry fields; both are still read (their `grid` is empty).
+/// Version 3 is version 4 without the graph section, version 2 version 3 without the grid
+/// section, version 1 version 2 without the four odometry fields; all are still read
+/// (their `graph`, and before version 3 their `grid`, are empty).
 
 namespace omnislam::io {
 
-inline constexpr std::uint32_t kSnapshotVersion = 3;
+inline constexpr std::uint32_t kSnapshotVersion = 4;
 
 /// A snapshot that cannot be used: missing, truncated, of another version, failing its
 /// checksum, or holding impossible values. The message names the file.
@@ -70,6 +80,10 @@ struct Snapshot {
   /// The trinary occupancy grid (free space included) of the same state, when the writer
   /// had one (version 3); a resumed service does not rebuild its log-odds from it.
   std::optional<grid::GridImage> grid;
+  /// The keyframe graph the map was built from, when the writer's graph described the map
+  /// (version 4; slam::Slam::graph_state): a resumed run continues it and can close loops
+  /// against its keyframes. Its integrations() equal map_integrations.
+  std::optional<slam::KeyframeGraphState> graph;
 };
 
 /// The bytes of the file format above.
@@ -77,7 +91,9 @@ struct Snapshot {
 
 /// Parses the file format; `name` is used in error messages. Throws SnapshotError on a
 /// truncated or oversized buffer, a bad magic, checksum or version, or a non-finite or
-/// impossible value (hits < 1, first_seen outside 0..map_integrations).
+/// impossible value (hits < 1, first_seen outside 0..map_integrations, a keyframe graph
+/// that slam::keyframe_graph_state_error rejects or whose integrations are not
+/// map_integrations).
 [[nodiscard]] Snapshot decode_snapshot(std::span<const std::uint8_t> bytes, const std::string &name);
 
 /// Writes `snapshot` so that `file` always holds either the previous or the new complete

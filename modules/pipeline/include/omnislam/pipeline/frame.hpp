@@ -75,6 +75,9 @@ struct Frame {
   std::shared_ptr<const std::vector<slam::MapPoint>> map;
   int map_integrations = 0;  ///< slam::PointMap::integrations() of `map`
   bool state_due = false;    ///< map is attached for a state snapshot (PipelineConfig::state_period_s)
+  /// With state_due: the keyframe graph of the same state (slam::Slam::graph_state), when
+  /// it describes the map; its scans are shared with the SLAM, not copied.
+  std::shared_ptr<const slam::KeyframeGraphState> graph;
   /// When a loop closure moved the map (estimate.map_rebuilt): every frame's corrected pose
   /// (slam::Slam::trajectory(), indexed by FrameEstimate::trajectory_index), for what was
   /// built from the poses as they were published (the occupancy grid).

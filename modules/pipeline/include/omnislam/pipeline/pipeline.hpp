@@ -80,17 +80,21 @@ class Pipeline {
   /// Stops and joins.
   ~Pipeline();
 
-  /// Continues from a saved SLAM state (slam::Slam::resume) instead of a new map. Only
-  /// before start().
+  /// Continues from a saved SLAM state (slam::Slam::resume, with the saved keyframe graph
+  /// when there is one) instead of a new map. Only before start().
   void resume(std::vector<slam::MapPoint> points, int integrations, const Eigen::Isometry2d &T_map_base,
-              const Eigen::Matrix3d &covariance, const std::optional<Eigen::Isometry2d> &T_odom_base);
+              const Eigen::Matrix3d &covariance, const std::optional<Eigen::Isometry2d> &T_odom_base,
+              std::optional<slam::ResumedGraph> graph = {});
 
   /// Starts on a saved map from an unknown pose (slam::Relocalizer): frames are searched
   /// for their pose on the map, and leave the SLAM stage with Frame::localized false until
   /// one pose is confirmed; from then on the SLAM continues from it on the saved map
-  /// (slam::Slam::resume). Only before start().
+  /// (slam::Slam::resume). With the map's saved keyframe graph, the SLAM continues it,
+  /// unchained (slam::ResumedGraph::chained false: the pose found is not the saved one).
+  /// Only before start().
   void relocalize(std::vector<slam::MapPoint> points, int integrations,
-                  const slam::RelocalizerConfig &config = {}, std::optional<slam::SearchWindow> window = {});
+                  const slam::RelocalizerConfig &config = {}, std::optional<slam::SearchWindow> window = {},
+                  std::optional<slam::KeyframeGraphState> graph = {});
 
   /// Starts the five threads. Call once.
   void start(FrameSource source);
@@ -156,6 +160,7 @@ class Pipeline {
   slam::RelocalizerConfig relocalizer_config_;
   std::vector<slam::MapPoint> saved_points_;
   int saved_integrations_ = 0;
+  std::optional<slam::KeyframeGraphState> saved_graph_;
   std::optional<slam::SearchWindow> window_;
   std::optional<Eigen::Isometry2d> window_odometry_;  ///< odometry of the last relocalised frame
   std::array<Queue, 4> queues_;

@@ -4,6 +4,7 @@
 #include <Eigen/Geometry>
 #include <cstddef>
 #include <memory>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -41,6 +42,47 @@ struct Keyframe {
   std::vector<std::shared_ptr<const Points2>> scans_keyframe;
 };
 
+/// A planar pose as three numbers, so that a saved graph reads back bit for bit.
+struct PlanarPose {
+  double x_m = 0.0;
+  double y_m = 0.0;
+  double yaw_rad = 0.0;
+};
+
+/// What a KeyframeGraph needs to continue in another process (io/snapshot.hpp stores it):
+/// the keyframes with their scans, the order the scans were integrated in, the pose-graph
+/// edges (the nodes are the keyframe poses), and where the path stands. Not the per-frame
+/// trajectory: a resumed run starts its own. The scans are shared, immutable, as in the
+/// graph, so exporting one from a running graph copies no points.
+struct KeyframeGraphState {
+  struct SavedKeyframe {
+    PlanarPose T_map_keyframe;
+    double path_m = 0.0;
+    std::vector<std::shared_ptr<const Points2>> scans_keyframe;  ///< keyframe coordinates
+  };
+  struct SavedEdge {
+    int from = 0;
+    int to = 0;
+    PlanarPose T_from_to;
+    Eigen::Matrix3d information = Eigen::Matrix3d::Identity();
+    bool loop = false;
+  };
+  std::vector<SavedKeyframe> keyframes;
+  std::vector<std::pair<int, int>> integration_order;  ///< (keyframe, scan within it)
+  std::vector<SavedEdge> edges;
+  double path_m = 0.0;    ///< travelled so far
+  PlanarPose last_frame;  ///< the last recorded frame's pose (the path continues from it)
+
+  /// Integrated scans (integration_order's size).
+  [[nodiscard]] std::size_t integrations() const { return integration_order.size(); }
+};
+
+/// What makes `state` unusable as a KeyframeGraph, or an empty string: non-finite values,
+/// negative or decreasing path lengths, a null scan, edge nodes out of range or equal, an
+/// information matrix that is not symmetric positive definite, an integration order that
+/// does not name every stored scan exactly once.
+[[nodiscard]] std::string keyframe_graph_state_error(const KeyframeGraphState &state);
+
 /// A stored scan and the pose it is integrated at.
 struct PlacedScan {
   std::shared_ptr<const Points2> scan_keyframe;  ///< keyframe coordinates, shared with the graph
@@ -50,6 +92,15 @@ struct PlacedScan {
 class KeyframeGraph {
  public:
   explicit KeyframeGraph(KeyframeConfig config = {}) : config_(config) {}
+  /// Continues a saved graph (std::invalid_argument when keyframe_graph_state_error finds
+  /// a fault). `chained`: the next keyframe is joined to the saved last one by a
+  /// sequential edge, as if the run had not stopped (the saved pose taken as is); false
+  /// (the pose found afresh, e.g. by relocalisation): the next integrated frame starts a
+  /// keyframe with no edge to the saved ones, which only loop closure then ties.
+  KeyframeGraph(KeyframeConfig config, const KeyframeGraphState &state, bool chained);
+
+  /// The state to save (keyframes, scans shared, integration order, edges, path).
+  [[nodiscard]] KeyframeGraphState state() const;
 
   /// Records an integrated frame at `T_map_base` with its scan (base_link); it becomes a
   /// keyframe (joined to the previous one by a sequential edge whose covariance is the
@@ -124,6 +175,9 @@ class KeyframeGraph {
   PoseGraph graph_;
   double path_m_ = 0.0;  ///< travelled so far, summed frame to frame
   Eigen::Isometry2d last_frame_ = Eigen::Isometry2d::Identity();
+  /// false after a resume whose pose does not continue the saved tracking: the next
+  /// integrated frame is a keyframe without a sequential edge.
+  bool chained_ = true;
 };
 
 }  // namespace omnislam::slam

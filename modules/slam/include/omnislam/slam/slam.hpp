@@ -97,6 +97,15 @@ struct FrameEstimate {
   int trajectory_index = -1;
 };
 
+/// A saved run's keyframe graph to resume with (Slam::resume).
+struct ResumedGraph {
+  KeyframeGraphState state;
+  /// The resumed pose continues the saved run's tracking (its saved pose taken as is): the
+  /// first new keyframe is joined to the saved last one by a sequential edge. false (a pose
+  /// found afresh on the map): only loop closure ties the new keyframes to the saved ones.
+  bool chained = true;
+};
+
 class Slam {
  public:
   explicit Slam(SlamConfig config = {})
@@ -120,8 +129,20 @@ class Slam {
   /// (the odometry frame must be the same: a dataset, a base driver that kept running);
   /// without it, the robot is taken not to have moved. Either way the next frame is
   /// registered against the restored map.
+  ///
+  /// With the saved run's keyframe graph (whose scans are exactly the map's: as many
+  /// integrations as `integrations`, else std::invalid_argument) and loop closure on, the
+  /// graph continues: new keyframes join it, loop closure can close loops against the saved
+  /// keyframes, and a loop's rebuilt map is made from all of them. Without one, the restored
+  /// points are a fixed base that the graph of the new keyframes is added to.
   void resume(std::vector<MapPoint> points, int integrations, const Eigen::Isometry2d &T_map_base,
-              const Eigen::Matrix3d &covariance, const std::optional<Eigen::Isometry2d> &T_odom_base = {});
+              const Eigen::Matrix3d &covariance, const std::optional<Eigen::Isometry2d> &T_odom_base = {},
+              std::optional<ResumedGraph> graph = {});
+
+  /// The keyframe graph to save with the map, when it describes the map (every map
+  /// integration is one of its scans): not with loop closure off, nor after a resume
+  /// without a graph (the restored points belong to no keyframe).
+  [[nodiscard]] std::optional<KeyframeGraphState> graph_state() const;
 
   /// An operator's pose (rt/initialpose): the next frame is predicted at `T_map_base`
   /// (the robot taken not to have moved since) and registered against the whole map, which
@@ -177,6 +198,8 @@ class Slam {
   /// optimisation and map rebuild). Returns the frame's pose after any correction.
   [[nodiscard]] Eigen::Isometry2d update_graph(const Points2 &scan_base, FrameEstimate &estimate);
   [[nodiscard]] LoopJob make_loop_job() const;
+  /// The graph resume() continues: `graph`, checked to hold the map's `integrations`.
+  [[nodiscard]] KeyframeGraph resumed_graph(const ResumedGraph &graph, int integrations) const;
   /// Applies a job's result to the graph and the map; returns the correction of the live
   /// pose (T_corrected_tracked: identity when no loop was confirmed).
   [[nodiscard]] Eigen::Isometry2d take_result(LoopResult result);
