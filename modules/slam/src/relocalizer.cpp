@@ -62,7 +62,7 @@ LocalizationResult Relocalizer::process(const Points2 &scan_base,
     if (static_cast<int>(scan_base.size()) >= config_.min_scan_points) {
       if (const auto refined = refine(scan_base, localized_->T_map_base)) {
         localized_->T_map_base = refined->T_model_sample;
-        localized_->covariance = refined->covariance;
+        localized_->covariance = refined->robust_covariance;
       }
     }
     result.state = LocalizationState::kLocalized;
@@ -98,7 +98,7 @@ LocalizationResult Relocalizer::process(const Points2 &scan_base,
     const auto refined = refine(scan_base, hypothesis.T_map_base);
     if (!refined) continue;
     hypothesis.T_map_base = refined->T_model_sample;
-    hypothesis.covariance = refined->covariance;
+    hypothesis.covariance = refined->robust_covariance;
     hypothesis.score = matcher_.score(scan_base, hypothesis.T_map_base);
     if (hypothesis.score < config_.min_score) continue;
     ++hypothesis.frames;
@@ -130,7 +130,7 @@ LocalizationResult Relocalizer::process(const Points2 &scan_base,
     if (!refined || known(refined->T_model_sample)) continue;
     const double score = matcher_.score(scan_base, refined->T_model_sample);
     if (!admissible(score)) continue;
-    alive.push_back({refined->T_model_sample, refined->covariance, score, 0.0, 1});
+    alive.push_back({refined->T_model_sample, refined->robust_covariance, score, 0.0, 1});
     frame_log_likelihood.push_back(weigh(refined->T_model_sample));
   }
   // Each hypothesis falls behind the frame's best by what this frame says (a new one: by

@@ -60,10 +60,11 @@ enum class LocalizationState { kSearching, kLocalized };
 struct LocalizationResult {
   LocalizationState state = LocalizationState::kSearching;
   Eigen::Isometry2d T_map_base = Eigen::Isometry2d::Identity();  ///< when localized
-  Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();          ///< of the last refinement (x, y, yaw)
-  int hypotheses = 0;                                            ///< alive after this frame
-  double best_score = 0.0;                                       ///< of the frame's best hypothesis
-  int searched_poses = 0;  ///< candidates the correlative search returned
+  Eigen::Matrix3d covariance =
+      Eigen::Matrix3d::Zero();  ///< of the last refinement (x, y, yaw), cluster-robust
+  int hypotheses = 0;           ///< alive after this frame
+  double best_score = 0.0;      ///< of the frame's best hypothesis
+  int searched_poses = 0;       ///< candidates the correlative search returned
 };
 
 class Relocalizer {
