@@ -14,13 +14,6 @@
 namespace omnislam::slam {
 namespace {
 
-// A (x, y, yaw) covariance given in the map frame, expressed in a frame turned by R.
-Eigen::Matrix3d in_frame(const Eigen::Matrix3d &covariance_map, const Eigen::Matrix2d &R_map_frame) {
-  Eigen::Matrix3d rotate = Eigen::Matrix3d::Identity();
-  rotate.topLeftCorner<2, 2>() = R_map_frame.transpose();
-  return rotate * covariance_map * rotate.transpose();
-}
-
 PlanarPose planar_of(const Eigen::Isometry2d &T) {
   return {T.translation().x(), T.translation().y(), yaw_rad_of(T)};
 }
@@ -176,7 +169,7 @@ bool KeyframeGraph::add_integrated(const Points2 &scan_base, const Eigen::Isomet
       const double sigma_xy = config_.edge_floor_xy_m + config_.drift_per_m * travelled_m;
       const double sigma_yaw = config_.edge_floor_yaw_rad + config_.drift_yaw_per_m * travelled_m;
       const Eigen::Matrix3d covariance =
-          in_frame(registration_covariance, previous.T_map_keyframe.linear()) +
+          rotated_covariance(registration_covariance, previous.T_map_keyframe.linear().transpose()) +
           Eigen::Vector3d(sigma_xy * sigma_xy, sigma_xy * sigma_xy, sigma_yaw * sigma_yaw)
               .asDiagonal()
               .toDenseMatrix();

@@ -31,13 +31,6 @@ Eigen::Matrix3d carried(const Eigen::Matrix3d &covariance, const Eigen::Isometry
   return F * covariance * F.transpose();
 }
 
-// An (x, y, yaw) covariance given in a frame turned by R, in the map frame.
-Eigen::Matrix3d in_map_frame(const Eigen::Matrix3d &covariance, const Eigen::Matrix2d &R) {
-  Eigen::Matrix3d rotate = Eigen::Matrix3d::Identity();
-  rotate.topLeftCorner<2, 2>() = R;
-  return rotate * covariance * rotate.transpose();
-}
-
 }  // namespace
 
 Eigen::Matrix3d Slam::published_covariance(const FrameEstimate &estimate,
@@ -54,7 +47,7 @@ Eigen::Matrix3d Slam::published_covariance(const FrameEstimate &estimate,
   Eigen::Matrix3d covariance = carried(previous_.covariance, previous_.T_map_base, estimate.T_map_base);
   covariance += estimate.integrated
                     ? estimate.registration.robust_covariance
-                    : in_map_frame(odometry_step_covariance(step), previous_.T_map_base.linear());
+                    : rotated_covariance(odometry_step_covariance(step), previous_.T_map_base.linear());
   return covariance;
 }
 

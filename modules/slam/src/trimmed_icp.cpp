@@ -91,20 +91,24 @@ struct NormalEquations {
   Eigen::Vector3d Jtr = Eigen::Vector3d::Zero();
 };
 
+// One pair's share of the normal equations: J^T J and J^T r.
+NormalEquations pair_terms(const Pair &pair, const Motion &motion) {
+  const Point2 moved = motion.apply(pair.sample);
+  Eigen::Matrix<double, 2, 3> J;
+  J << 1.0, 0.0, -moved.y(), 0.0, 1.0, moved.x();
+  if (!pair.normal.isZero()) {
+    const Eigen::RowVector3d row = pair.normal.transpose() * J;
+    return {row.transpose() * row, row.transpose() * pair.normal.dot(moved - pair.model)};
+  }
+  return {J.transpose() * J, J.transpose() * (moved - pair.model)};
+}
+
 NormalEquations normal_equations(const std::vector<Pair> &pairs, const Motion &motion) {
   NormalEquations eq;
   for (const Pair &pair : pairs) {
-    const Point2 moved = motion.apply(pair.sample);
-    Eigen::Matrix<double, 2, 3> J;
-    J << 1.0, 0.0, -moved.y(), 0.0, 1.0, moved.x();
-    if (!pair.normal.isZero()) {
-      const Eigen::RowVector3d row = pair.normal.transpose() * J;
-      eq.JtJ += row.transpose() * row;
-      eq.Jtr += row.transpose() * pair.normal.dot(moved - pair.model);
-    } else {
-      eq.JtJ += J.transpose() * J;
-      eq.Jtr += J.transpose() * (moved - pair.model);
-    }
+    const NormalEquations terms = pair_terms(pair, motion);
+    eq.JtJ += terms.JtJ;
+    eq.Jtr += terms.Jtr;
   }
   return eq;
 }
@@ -157,21 +161,11 @@ Eigen::Matrix3d robust_covariance_of(const std::vector<Pair> &pairs, const Motio
   std::vector<bool> used(static_cast<std::size_t>(sectors), false);
   Eigen::Matrix3d A = Eigen::Matrix3d::Zero();
   for (const Pair &pair : pairs) {
-    const Point2 moved = motion.apply(pair.sample);
-    Eigen::Matrix<double, 2, 3> J;
-    J << 1.0, 0.0, -moved.y(), 0.0, 1.0, moved.x();
     const double bearing = std::atan2(pair.sample.y(), pair.sample.x()) + std::numbers::pi;
     const auto sector = std::min(sectors - 1, static_cast<int>(bearing / (2.0 * std::numbers::pi) * sectors));
-    Eigen::Vector3d score;
-    if (!pair.normal.isZero()) {
-      const Eigen::RowVector3d row = pair.normal.transpose() * J;
-      A += row.transpose() * row;
-      score = row.transpose() * pair.normal.dot(moved - pair.model);
-    } else {
-      A += J.transpose() * J;
-      score = J.transpose() * (moved - pair.model);
-    }
-    scores[static_cast<std::size_t>(sector)] += score;
+    const NormalEquations terms = pair_terms(pair, motion);
+    A += terms.JtJ;
+    scores[static_cast<std::size_t>(sector)] += terms.Jtr;
     used[static_cast<std::size_t>(sector)] = true;
   }
   const auto clusters = static_cast<double>(std::count(used.begin(), used.end(), true));

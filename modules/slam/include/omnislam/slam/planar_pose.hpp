@@ -31,4 +31,13 @@ namespace omnislam::slam {
   return out;
 }
 
+/// An (x, y, yaw) covariance given in one frame, expressed in another: R rotates vectors
+/// from the first frame into the second (a keyframe's linear() takes keyframe to map).
+[[nodiscard]] inline Eigen::Matrix3d rotated_covariance(const Eigen::Matrix3d &covariance,
+                                                        const Eigen::Matrix2d &R) {
+  Eigen::Matrix3d rotate = Eigen::Matrix3d::Identity();
+  rotate.topLeftCorner<2, 2>() = R;
+  return rotate * covariance * rotate.transpose();
+}
+
 }  // namespace omnislam::slam
