@@ -36,6 +36,18 @@ int polarity(const vision::EdgeImage &edges, int row, int column) {
   return edges.grad_row.at<std::int16_t>(row, column) >= 0 ? 1 : -1;
 }
 
+// interpolate()'s arithmetic for a whole panorama row: the two rows around `row` of a lobe
+// with `rows` rows and the fraction between them.
+struct RowBlend {
+  int below = 0;
+  float fraction = 0.0f;
+};
+RowBlend row_blend(float row, int rows) {
+  const float clamped = std::clamp(row, 0.0f, static_cast<float>(rows - 1));
+  const int below = std::min(rows - 2, static_cast<int>(clamped));
+  return {below, clamped - static_cast<float>(below)};
+}
+
 float median_of(std::vector<float> &values) {
   if (values.empty()) return kNaN;
   const auto middle = values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2);
@@ -58,9 +70,7 @@ FloorBoundaryFinder::FloorBoundaryFinder(const FloorBoundaryConfig &config)
     : config_(config), decision_llr_(std::log((1.0 - config.error_rate) / config.error_rate)) {}
 
 float FloorBoundaryFinder::interpolate(const float *line, float row) const {
-  const float clamped = std::clamp(row, 0.0f, static_cast<float>(rows_ - 1));
-  const int below = std::min(rows_ - 2, static_cast<int>(clamped));
-  const float fraction = clamped - static_cast<float>(below);
+  const auto [below, fraction] = row_blend(row, rows_);
   return line[below] + fraction * (line[below + 1] - line[below]);
 }
 
@@ -70,10 +80,10 @@ float FloorBoundaryFinder::outer_at(float row, int column) const {
 
 void FloorBoundaryFinder::prepare(const cv::Mat &inner_texture, const cv::Mat &outer_texture) {
   // Smoothed, then stored column by column: every later loop walks one column's rows.
-  cv::GaussianBlur(inner_texture, smoothed_, cv::Size(5, 5), 1.0, 1.0, cv::BORDER_REPLICATE);
-  cv::transpose(smoothed_, inner_);
-  cv::GaussianBlur(outer_texture, smoothed_, cv::Size(5, 5), 1.0, 1.0, cv::BORDER_REPLICATE);
-  cv::transpose(smoothed_, outer_);
+  cv::GaussianBlur(inner_texture, smoothed_inner_, cv::Size(5, 5), 1.0, 1.0, cv::BORDER_REPLICATE);
+  cv::transpose(smoothed_inner_, inner_);
+  cv::GaussianBlur(outer_texture, smoothed_outer_, cv::Size(5, 5), 1.0, 1.0, cv::BORDER_REPLICATE);
+  cv::transpose(smoothed_outer_, outer_);
   rows_ = inner_texture.rows;
   const int rows = rows_, columns = inner_texture.cols;
   inner_radius_squared_.resize(static_cast<std::size_t>(rows));
@@ -87,22 +97,29 @@ void FloorBoundaryFinder::prepare(const cv::Mat &inner_texture, const cv::Mat &o
     const float outer_row = geometry_->floor_outer_row(row);
     floor_gain_[static_cast<std::size_t>(row)] = std::isfinite(outer_row) ? gain(row, outer_row) : kNaN;
   }
-  floor_residual_.create(columns, rows, CV_32FC1);
-  for (int column = 0; column < columns; ++column) {  // column-major, like the textures
-    float *residual = floor_residual_.ptr<float>(column);
-    const float *inner = inner_.ptr<float>(column), *outer = outer_.ptr<float>(column);
-    for (int row = 0; row < rows; ++row) {
-      const float g = floor_gain_[static_cast<std::size_t>(row)];
-      residual[row] = std::isfinite(g)
-                          ? std::abs(inner[row] - g * interpolate(outer, geometry_->floor_outer_row(row)))
-                          : kNaN;
+  // The floor's outer row is the same in every column, so the residual is computed a whole
+  // panorama row at a time (contiguous, vectorised) and then transposed like the textures.
+  floor_residual_rows_.create(rows, columns, CV_32FC1);
+  for (int row = 0; row < rows; ++row) {
+    float *residual = floor_residual_rows_.ptr<float>(row);
+    const float g = floor_gain_[static_cast<std::size_t>(row)];
+    if (!std::isfinite(g)) {
+      std::fill_n(residual, columns, kNaN);
+      continue;
     }
+    const auto [below, fraction] = row_blend(geometry_->floor_outer_row(row), rows);
+    const float *inner = smoothed_inner_.ptr<float>(row);
+    const float *low = smoothed_outer_.ptr<float>(below), *high = smoothed_outer_.ptr<float>(below + 1);
+    for (int column = 0; column < columns; ++column)
+      residual[column] =
+          std::abs(inner[column] - g * (low[column] + fraction * (high[column] - low[column])));
   }
+  cv::transpose(floor_residual_rows_, floor_residual_);
   measure_noise_scale();
 }
 
 void FloorBoundaryFinder::fit_lobe_gain() {
-  const int rows = rows_, columns = inner_.rows;
+  const int rows = rows_, columns = smoothed_inner_.cols;
   // The lobes differ in brightness by the mirror's reflectance and the lens's radial
   // falloff (vignetting), both functions of the image radius. Fit the first-order model of
   // gain() to the median brightness ratio of each row nearest the robot, where nearly
@@ -114,8 +131,12 @@ void FloorBoundaryFinder::fit_lobe_gain() {
     const float outer_row = geometry_->floor_outer_row(row);
     if (!std::isfinite(outer_row)) continue;
     ratios_.clear();
+    const auto [below, fraction] = row_blend(outer_row, rows);
+    const float *inner_line = smoothed_inner_.ptr<float>(row);
+    const float *low = smoothed_outer_.ptr<float>(below), *high = smoothed_outer_.ptr<float>(below + 1);
     for (int column = 0; column < columns; column += 2) {
-      const float inner = inner_px(row, column), outer = outer_at(outer_row, column);
+      const float inner = inner_line[column];
+      const float outer = low[column] + fraction * (high[column] - low[column]);
       if (inner > kDarkLevel && outer > kDarkLevel) ratios_.push_back(inner / outer);
     }
     if (ratios_.size() * 4 < static_cast<std::size_t>(columns)) continue;
@@ -133,14 +154,14 @@ void FloorBoundaryFinder::fit_lobe_gain() {
 }
 
 void FloorBoundaryFinder::measure_noise_scale() {
-  const int rows = rows_, columns = inner_.rows;
+  const int rows = rows_, columns = floor_residual_rows_.cols;
   // From the rows nearest the robot, mostly floor in any room: a Laplace distribution's
   // scale is its median absolute value over ln 2 (every other row and column is plenty).
   ratios_.clear();
-  for (int column = 0; column < columns; column += 2) {
-    const float *residual = floor_residual_.ptr<float>(column);
-    for (int row = rows / 2; row < rows; row += 2) {
-      if (std::isfinite(residual[row])) ratios_.push_back(residual[row]);
+  for (int row = rows / 2; row < rows; row += 2) {
+    const float *residual = floor_residual_rows_.ptr<float>(row);
+    for (int column = 0; column < columns; column += 2) {
+      if (std::isfinite(residual[column])) ratios_.push_back(residual[column]);
     }
   }
   const float median = median_of(ratios_);

@@ -147,7 +147,7 @@ class FloorBoundaryFinder {
   FloorBoundaryConfig config_;
   double decision_llr_ = 0.0;
   int rows_ = 0;
-  cv::Mat smoothed_;
+  cv::Mat smoothed_inner_, smoothed_outer_, floor_residual_rows_;  ///< row-major scratch
   cv::Mat inner_;           ///< smoothed inner texture, transposed: one matrix row per column
   cv::Mat outer_;           ///< smoothed outer texture, transposed
   cv::Mat floor_residual_;  ///< |inner - gain * outer at the floor row|, transposed like them
