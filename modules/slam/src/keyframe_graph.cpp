@@ -14,6 +14,23 @@
 namespace omnislam::slam {
 namespace {
 
+// How the optimisation moved the newest keyframe of a copy of the first `copied` keyframes.
+Eigen::Isometry2d newest_correction(const std::vector<Keyframe> &solved, const std::vector<Keyframe> &live,
+                                    std::size_t copied) {
+  if (copied == 0) return Eigen::Isometry2d::Identity();
+  return solved[copied - 1].T_map_keyframe * live[copied - 1].T_map_keyframe.inverse();
+}
+
+// Keyframe k's pose once `solved` is adopted: its optimised pose, or for a keyframe made
+// since the copy, its tracked pose moved like the copy's newest keyframe (re-made a
+// rotation: repeated corrections would otherwise compound the rounding, planar_pose.hpp).
+Eigen::Isometry2d corrected_pose(std::size_t k, std::size_t copied, const std::vector<Keyframe> &solved,
+                                 const std::vector<Keyframe> &live,
+                                 const Eigen::Isometry2d &T_corrected_tracked) {
+  return k < copied ? solved[k].T_map_keyframe
+                    : orthonormalized(T_corrected_tracked * live[k].T_map_keyframe);
+}
+
 PlanarPose planar_of(const Eigen::Isometry2d &T) {
   return {T.translation().x(), T.translation().y(), yaw_rad_of(T)};
 }
@@ -250,17 +267,12 @@ KeyframeGraph KeyframeGraph::without_trajectory() const {
 
 std::vector<PlacedScan> KeyframeGraph::scans_since(std::size_t first, const KeyframeGraph &solved) const {
   const std::size_t copied = std::min(solved.keyframes_.size(), keyframes_.size());
-  const Eigen::Isometry2d T_corrected_tracked =
-      copied == 0
-          ? Eigen::Isometry2d::Identity()
-          : solved.keyframes_[copied - 1].T_map_keyframe * keyframes_[copied - 1].T_map_keyframe.inverse();
+  const Eigen::Isometry2d T_corrected_tracked = newest_correction(solved.keyframes_, keyframes_, copied);
   std::vector<PlacedScan> scans;
   for (std::size_t i = first; i < integration_order_.size(); ++i) {
     const auto k = static_cast<std::size_t>(integration_order_[i].first);
-    const Eigen::Isometry2d pose =
-        k < copied ? solved.keyframes_[k].T_map_keyframe : T_corrected_tracked * keyframes_[k].T_map_keyframe;
-    scans.push_back(
-        {keyframes_[k].scans_keyframe[static_cast<std::size_t>(integration_order_[i].second)], pose});
+    scans.push_back({keyframes_[k].scans_keyframe[static_cast<std::size_t>(integration_order_[i].second)],
+                     corrected_pose(k, copied, solved.keyframes_, keyframes_, T_corrected_tracked)});
   }
   return scans;
 }
@@ -268,12 +280,10 @@ std::vector<PlacedScan> KeyframeGraph::scans_since(std::size_t first, const Keyf
 Eigen::Isometry2d KeyframeGraph::adopt(const KeyframeGraph &solved, std::size_t copied_edges) {
   const std::size_t copied = solved.keyframes_.size();
   if (copied == 0 || copied > keyframes_.size()) return Eigen::Isometry2d::Identity();
-  const Eigen::Isometry2d T_corrected_tracked =
-      solved.keyframes_[copied - 1].T_map_keyframe * keyframes_[copied - 1].T_map_keyframe.inverse();
-  for (std::size_t k = 0; k < keyframes_.size(); ++k) {
-    Eigen::Isometry2d &pose = keyframes_[k].T_map_keyframe;
-    pose = k < copied ? solved.keyframes_[k].T_map_keyframe : T_corrected_tracked * pose;
-  }
+  const Eigen::Isometry2d T_corrected_tracked = newest_correction(solved.keyframes_, keyframes_, copied);
+  for (std::size_t k = 0; k < keyframes_.size(); ++k)
+    keyframes_[k].T_map_keyframe =
+        corrected_pose(k, copied, solved.keyframes_, keyframes_, T_corrected_tracked);
   // The solved graph (its loop edges, without those it rejected), then what was added here
   // since the copy: the new keyframes' nodes and their sequential edges.
   PoseGraph graph = solved.graph_;

@@ -306,8 +306,8 @@ void Slam::apply_loop_result(LoopResult result) {
   if (!closed_since_frame_) return;
   // The tracking state follows the correction: the next frame is predicted from the
   // corrected pose and registered against the corrected map.
-  previous_.T_map_base = T_corrected_tracked * previous_.T_map_base;
-  anchor_T_map_base_ = T_corrected_tracked * anchor_T_map_base_;
+  previous_.T_map_base = orthonormalized(T_corrected_tracked * previous_.T_map_base);
+  anchor_T_map_base_ = orthonormalized(T_corrected_tracked * anchor_T_map_base_);
   for (Points2 &scan : recent_scans_map_) scan = transformed(scan, T_corrected_tracked);
 }
 

@@ -23,6 +23,15 @@ namespace omnislam::slam {
   return T;
 }
 
+/// `T` with its rotation part made a rotation again (same translation and yaw). Eigen's
+/// Isometry2d::inverse() takes the transpose of linear() for its inverse, so a correction
+/// composed as `A * B.inverse()` and applied to B again squares B's rounding error in scale
+/// (det(linear) 1 - e becomes 1 - 2e): repeated, it grows exponentially. Every pose that
+/// such a correction moves is re-made with this.
+[[nodiscard]] inline Eigen::Isometry2d orthonormalized(const Eigen::Isometry2d &T) {
+  return planar_pose(T.translation().x(), T.translation().y(), yaw_rad_of(T));
+}
+
 /// The points moved by `T` (base_link -> map, keyframe -> map, ...).
 [[nodiscard]] inline Points2 transformed(const Points2 &points, const Eigen::Isometry2d &T) {
   Points2 out;
