@@ -157,3 +157,26 @@ TEST_CASE("SLAM: the published covariance carries the previous pose's and adds e
   CHECK_FALSE(blind.integrated);
   CHECK(blind.covariance(0, 0) > previous(0, 0));
 }
+
+TEST_CASE("SLAM: frames without odometry extrapolate the last motion and keep the pose a rotation",
+          "[slam]") {
+  // The extrapolated step is the last pose's inverse times this one's; Isometry2d::inverse()
+  // transposes, so a step taken from poses whose rotation has rounding error feeds it back
+  // multiplied: it must be re-made a rotation (planar_pose.hpp orthonormalized()).
+  const auto path = lap(false, {{0, 0}, {2, 0}, {2, 2}, {0, 2}, {0, 0}, {2, 0}, {2, 2}, {0, 2}, {0, 0}});
+  std::mt19937_64 rng(8);
+  Slam slam;
+  double worst_scale_error = 0.0, worst_m = 0.0;
+  for (const Eigen::Isometry2d &truth : path) {
+    const auto estimate =
+        slam.process(omnislam::test::scan_from(omnislam::test::square_room(), truth, rng), std::nullopt);
+    worst_scale_error =
+        std::max(worst_scale_error, std::abs(estimate.T_map_base.linear().determinant() - 1.0));
+    worst_m = std::max(
+        worst_m, (estimate.T_map_base.translation() - (path.front().inverse() * truth).translation()).norm());
+  }
+  INFO("worst |det - 1| " << worst_scale_error << ", worst error " << worst_m << " m over " << path.size()
+                          << " frames");
+  CHECK(worst_scale_error < 1e-12);
+  CHECK(worst_m < 0.05);
+}

@@ -377,7 +377,8 @@ FrameEstimate Slam::process(const Points2 &scan_base, const std::optional<Eigen:
   closed_since_frame_ = rebuilt_since_frame_ = false;
   previous_failed_ = !estimate.integrated;
   if (T_odom_base) set_anchor(*T_odom_base, estimate.T_map_base);
-  last_step_ = previous_.T_map_base.inverse() * estimate.T_map_base;  // extrapolated through gaps
+  // Extrapolated through gaps, re-made a rotation: the inverse transposes (planar_pose.hpp).
+  last_step_ = orthonormalized(previous_.T_map_base.inverse() * estimate.T_map_base);
   // Thesis fig. 5.3: second_last = last every iteration, integrated or not.
   recent_scans_map_.push_front(transformed(scan_base, estimate.T_map_base));
   if (recent_scans_map_.size() > 3) recent_scans_map_.pop_back();
