@@ -150,14 +150,55 @@ Eigen::Matrix3d covariance_of(const std::vector<Pair> &pairs, const Motion &moti
   return std::max(error_m2, 1e-8) * eq.JtJ.inverse();
 }
 
+// A cluster's score J_g^T r_g with its residuals first divided by (I - H_gg)^(1/2), H_gg =
+// J_g A^-1 J_g^T the cluster's leverage (the bias-reduced linearisation of Bell and
+// McCaffrey, "CR2"): a cluster that alone pins a direction (one wall for the motion along
+// its normal) has that direction's residuals fitted away, and the plain score would say it
+// made no error there. In the basis of J_g's singular vectors (J_g = U S V^T) every matrix
+// is 3 x 3: H_gg = U M U^T with M = S V^T A^-1 V S.
+Eigen::Vector3d leverage_adjusted_score(const Eigen::Matrix3d &A_g, const Eigen::Vector3d &b_g,
+                                        const Eigen::Matrix3d &A_inverse) {
+  // Leverage never reaches 1 by more than this: the cluster's error along a direction only it
+  // constrains is then taken as 10x what its residuals show.
+  constexpr double kMinFreedom = 1e-2;
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> gram(A_g);
+  const double largest = gram.eigenvalues().maxCoeff();
+  if (!(largest > 0.0)) return b_g;
+  Eigen::Vector3d adjusted = b_g;
+  // Directions J_g spans (singular values above rounding), S and V restricted to them.
+  Eigen::Matrix3d V = Eigen::Matrix3d::Zero();
+  Eigen::Vector3d S = Eigen::Vector3d::Zero();
+  int rank = 0;
+  for (int i = 0; i < 3; ++i) {
+    if (gram.eigenvalues()(i) > 1e-12 * largest) {
+      V.col(rank) = gram.eigenvectors().col(i);
+      S(rank) = std::sqrt(gram.eigenvalues()(i));
+      ++rank;
+    }
+  }
+  const Eigen::MatrixXd Vk = V.leftCols(rank);
+  const Eigen::VectorXd Sk = S.head(rank);
+  const Eigen::MatrixXd M = Sk.asDiagonal() * Vk.transpose() * A_inverse * Vk * Sk.asDiagonal();
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> leverage(0.5 * (M + M.transpose()));
+  Eigen::VectorXd stretch(rank);
+  for (int i = 0; i < rank; ++i)
+    stretch(i) = 1.0 / std::sqrt(std::max(kMinFreedom, 1.0 - leverage.eigenvalues()(i))) - 1.0;
+  const Eigen::MatrixXd &Q = leverage.eigenvectors();
+  // s_g = J_g^T (I + U Q D Q^T U^T) r_g = b_g + V S Q D Q^T S^-1 V^T b_g.
+  adjusted += Vk * Sk.asDiagonal() * Q * stretch.asDiagonal() * Q.transpose() *
+              Sk.cwiseInverse().asDiagonal() * Vk.transpose() * b_g;
+  return adjusted;
+}
+
 // Cluster-robust covariance (the sandwich A^-1 B A^-1 with A = J^T J and B the sum over
-// clusters of the outer product of each cluster's score J_g^T r_g; G / (G - 1), the usual
-// small-sample correction): residuals are free to be correlated inside a cluster, and only
-// the clusters are taken as independent. Clusters are bearing sectors of the sample frame.
+// clusters of the outer product of each cluster's leverage-adjusted score): residuals are
+// free to be correlated inside a cluster, and only the clusters are taken as independent.
+// Clusters are bearing sectors of the sample frame.
 Eigen::Matrix3d robust_covariance_of(const std::vector<Pair> &pairs, const Motion &motion, int sectors,
                                      const Eigen::Matrix3d &independent) {
   if (sectors < 2) return independent;
   std::vector<Eigen::Vector3d> scores(static_cast<std::size_t>(sectors), Eigen::Vector3d::Zero());
+  std::vector<Eigen::Matrix3d> grams(static_cast<std::size_t>(sectors), Eigen::Matrix3d::Zero());
   std::vector<bool> used(static_cast<std::size_t>(sectors), false);
   Eigen::Matrix3d A = Eigen::Matrix3d::Zero();
   for (const Pair &pair : pairs) {
@@ -166,14 +207,19 @@ Eigen::Matrix3d robust_covariance_of(const std::vector<Pair> &pairs, const Motio
     const NormalEquations terms = pair_terms(pair, motion);
     A += terms.JtJ;
     scores[static_cast<std::size_t>(sector)] += terms.Jtr;
+    grams[static_cast<std::size_t>(sector)] += terms.JtJ;
     used[static_cast<std::size_t>(sector)] = true;
   }
   const auto clusters = static_cast<double>(std::count(used.begin(), used.end(), true));
   if (clusters < 2.0 || std::abs(A.determinant()) < 1e-12) return independent;
-  Eigen::Matrix3d B = Eigen::Matrix3d::Zero();
-  for (const Eigen::Vector3d &score : scores) B += score * score.transpose();
   const Eigen::Matrix3d A_inverse = A.inverse();
-  const Eigen::Matrix3d sandwich = clusters / (clusters - 1.0) * A_inverse * B * A_inverse;
+  Eigen::Matrix3d B = Eigen::Matrix3d::Zero();
+  for (std::size_t g = 0; g < scores.size(); ++g) {
+    if (!used[g]) continue;
+    const Eigen::Vector3d score = leverage_adjusted_score(grams[g], scores[g], A_inverse);
+    B += score * score.transpose();
+  }
+  const Eigen::Matrix3d sandwich = A_inverse * B * A_inverse;
   // Never more confident than the independent estimate in any direction: in coordinates
   // where that one is the identity, the sandwich's variances below 1 are raised to 1.
   const Eigen::LLT<Eigen::Matrix3d> independent_factor(independent);
