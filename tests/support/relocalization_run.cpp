@@ -36,6 +36,9 @@ LocalizationRun build_localization_run(const std::filesystem::path &dir) {
     run.scans.push_back(std::move(points));
   }
   for (const slam::MapPoint &p : slam.map().points()) run.map.push_back(p.position_m);
+  run.mapped = slam.trajectory();
+  if (run.mapped.size() != run.scans.size())
+    throw std::runtime_error(dir.string() + ": the mapping run left no pose for some frames");
   return run;
 }
 
@@ -52,7 +55,7 @@ RelocalizationOutcome relocalize_from_every_frame(const LocalizationRun &run, in
       outcome.frame_ms.push_back(
           std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - begin).count());
       if (result.state != slam::LocalizationState::kLocalized) continue;
-      const Eigen::Isometry2d error = run.truth[index].inverse() * result.T_map_base;
+      const Eigen::Isometry2d error = run.mapped[index].inverse() * result.T_map_base;
       const double error_m = error.translation().norm();
       const double error_deg = std::abs(slam::yaw_rad_of(error)) * 180.0 / std::numbers::pi;
       ++outcome.localized;
