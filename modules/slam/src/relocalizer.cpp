@@ -37,6 +37,17 @@ bool Relocalizer::same_pose(const Eigen::Isometry2d &a, const Eigen::Isometry2d 
              config_.distinct_rad;
 }
 
+double Relocalizer::log_likelihood(const Points2 &scan_base, const Eigen::Isometry2d &T_map_base) const {
+  const Points2 thinned = matcher_.thinned(scan_base);
+  const double reach_m = 2.0 * matcher_.config().sigma_m;
+  const auto explained =
+      static_cast<double>(std::count_if(thinned.begin(), thinned.end(), [&](const Point2 &p) {
+        return map_index_.nearest(T_map_base * p, reach_m).has_value();
+      }));
+  return config_.point_correlation * (static_cast<double>(thinned.size()) - explained) *
+         std::log(config_.outlier_share);
+}
+
 std::optional<TrimmedIcpResult> Relocalizer::refine(const Points2 &scan_base,
                                                     const Eigen::Isometry2d &guess) const {
   const TrimmedIcpResult fit = register_trimmed_icp(map_index_, scan_base, guess, config_.icp);
@@ -91,9 +102,7 @@ LocalizationResult Relocalizer::process(const Points2 &scan_base,
   };
   std::vector<Hypothesis> alive;
   std::vector<double> frame_log_likelihood;
-  const auto weigh = [&](const Eigen::Isometry2d &pose) {
-    return config_.point_correlation * matcher_.log_likelihood(scan_base, pose, config_.outlier_share);
-  };
+  const auto weigh = [&](const Eigen::Isometry2d &pose) { return log_likelihood(scan_base, pose); };
   for (Hypothesis hypothesis : hypotheses_) {
     const auto refined = refine(scan_base, hypothesis.T_map_base);
     if (!refined) continue;

@@ -60,13 +60,15 @@ class CorrelativeMatcher {
                                       double outlier_share) const;
 
   [[nodiscard]] bool empty() const { return width_ == 0; }
+  /// The scan thinned to one point per scan_voxel_m cell (what search and log_likelihood use).
+  [[nodiscard]] Points2 thinned(const Points2 &scan_base) const;
+  [[nodiscard]] const CorrelativeMatcherConfig &config() const { return config_; }
 
  private:
   /// Value of level `level` at cell (x, y); 0 outside the grid.
   [[nodiscard]] float at(int level, int x, int y) const;
   /// Score of one map-frame point, bilinear in the likelihood grid.
   [[nodiscard]] double point_score(const Eigen::Vector2d &point_map) const;
-  [[nodiscard]] Points2 thinned(const Points2 &scan_base) const;
 
   CorrelativeMatcherConfig config_;
   Eigen::Vector2d origin_m_ = Eigen::Vector2d::Zero();  ///< map position of cell (0, 0)'s corner
