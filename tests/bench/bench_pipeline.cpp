@@ -36,6 +36,9 @@ struct Data {
   std::vector<cv::Mat> images;
   std::vector<Eigen::Isometry2d> odometry;
   std::vector<Eigen::Isometry2d> groundtruth;  ///< empty when the dataset has none
+  /// What moves one loop's odometry onto the next's: the odometry accumulated over a loop,
+  /// then the true step from the last pose back to the first (identity without ground truth).
+  Eigen::Isometry2d seam = Eigen::Isometry2d::Identity();
   stereo::ScanConfig scan;
 
   /// Odometry of frame `f` of the dataset looped: the robot drives from the last pose back
@@ -43,14 +46,9 @@ struct Data {
   /// odometry stays continuous, as a robot's does on a long stay. Without ground truth the
   /// odometry jumps back to its start (a robot carried back to where it began).
   [[nodiscard]] Eigen::Isometry2d looped_odometry(std::size_t f) const {
-    const std::size_t n = odometry.size(), loop = f / n;
-    if (groundtruth.size() != n || n == 0) return odometry[f % n];
-    // Each loop's odometry is the first loop's, moved by the seam: the accumulated odometry
-    // at the end of a loop, then the true step back to the start.
-    const Eigen::Isometry2d seam =
-        odometry[n - 1] * groundtruth[n - 1].inverse() * groundtruth[0] * odometry[0].inverse();
+    const std::size_t n = odometry.size();
     Eigen::Isometry2d offset = Eigen::Isometry2d::Identity();
-    for (std::size_t k = 0; k < loop; ++k) offset = offset * seam;
+    for (std::size_t loop = 0; loop < f / n; ++loop) offset = offset * seam;
     return offset * odometry[f % n];
   }
 };
@@ -62,6 +60,10 @@ Data load(const std::filesystem::path &dir) {
   data.scan.camera_height_m = info.camera_height_m;
   data.odometry = io::to_isometries(io::read_tum_file(info.odometry));
   if (!info.groundtruth.empty()) data.groundtruth = io::to_isometries(io::read_tum_file(info.groundtruth));
+  const std::size_t n = data.odometry.size();
+  if (n > 0 && data.groundtruth.size() == n)
+    data.seam = data.odometry[n - 1] * data.groundtruth[n - 1].inverse() * data.groundtruth[0] *
+                data.odometry[0].inverse();
   for (int i = 1; i <= info.frames; ++i)
     data.images.push_back(io::read_camera_image(info.image(i), data.scan.camera));
   return data;

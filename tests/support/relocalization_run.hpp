@@ -16,7 +16,6 @@ namespace omnislam::test {
 struct LocalizationRun {
   std::vector<slam::Points2> scans;         ///< base_link, per frame
   std::vector<Eigen::Isometry2d> odometry;  ///< the dataset's noisy odometry
-  std::vector<Eigen::Isometry2d> truth;     ///< map frame = the first frame's pose
   /// Each frame's pose in the saved map, as the mapping run left it (its optimised
   /// trajectory): where a relocaliser should put the frame. On a room it is within a few mm
   /// of the truth; on a building floor the map itself is bent by up to ~0.15 m.

@@ -102,7 +102,6 @@ LocalizationResult Relocalizer::process(const Points2 &scan_base,
   };
   std::vector<Hypothesis> alive;
   std::vector<double> frame_log_likelihood;
-  const auto weigh = [&](const Eigen::Isometry2d &pose) { return log_likelihood(scan_base, pose); };
   for (Hypothesis hypothesis : hypotheses_) {
     const auto refined = refine(scan_base, hypothesis.T_map_base);
     if (!refined) continue;
@@ -112,7 +111,7 @@ LocalizationResult Relocalizer::process(const Points2 &scan_base,
     if (hypothesis.score < config_.min_score) continue;
     ++hypothesis.frames;
     alive.push_back(hypothesis);
-    frame_log_likelihood.push_back(weigh(hypothesis.T_map_base));
+    frame_log_likelihood.push_back(log_likelihood(scan_base, hypothesis.T_map_base));
   }
   // 4. Every other candidate is a new hypothesis, with no history, unless the coarse grid
   //    already puts it out of the running (no refinement for those: in a building of alike
@@ -140,7 +139,7 @@ LocalizationResult Relocalizer::process(const Points2 &scan_base,
     const double score = matcher_.score(scan_base, refined->T_model_sample);
     if (!admissible(score)) continue;
     alive.push_back({refined->T_model_sample, refined->robust_covariance, score, 0.0, 1});
-    frame_log_likelihood.push_back(weigh(refined->T_model_sample));
+    frame_log_likelihood.push_back(log_likelihood(scan_base, refined->T_model_sample));
   }
   // Each hypothesis falls behind the frame's best by what this frame says (a new one: by
   // this frame alone); the leader is at zero, and who trails by the decision margin is out.

@@ -89,7 +89,6 @@ class Relocalizer {
     double deficit = 0.0;  ///< summed log-likelihood behind the best hypothesis (>= 0)
     int frames = 0;        ///< consecutive frames it was confirmed in
   };
-  /// ICP from `guess` against the map; nullopt when the fit is rejected.
   /// Log-likelihood of the (thinned) scan at a refined pose, times point_correlation: each
   /// point is explained (a map point within 2 sigma of the matcher, the 0.1 m the refinement
   /// counts too) or an outlier (probability outlier_share). Hypotheses are weighed by which
@@ -98,6 +97,7 @@ class Relocalizer {
   /// where the map's points fall between cells) turned that noise into evidence, enough to
   /// drop the true pose beside a wrong corridor in three frames.
   [[nodiscard]] double log_likelihood(const Points2 &scan_base, const Eigen::Isometry2d &T_map_base) const;
+  /// ICP from `guess` against the map; nullopt when the fit is rejected.
   [[nodiscard]] std::optional<TrimmedIcpResult> refine(const Points2 &scan_base,
                                                        const Eigen::Isometry2d &guess) const;
   [[nodiscard]] bool same_pose(const Eigen::Isometry2d &a, const Eigen::Isometry2d &b) const;
