@@ -1,6 +1,8 @@
 """`omnislam calibrate target`: every rig parameter from rendered images of a chessboard held
 round the robot and laid on the floor (datasets/calib-target-rig, a rig at the issue's
-limits, truth in its truth.yaml); the report, the YAML --config reads back, bad input."""
+limits, truth in its truth.yaml); the report, the YAML --config reads back, a replay with
+the calibrated rig (datasets/sim-room-37-target-rig), bad input."""
+import json
 import os
 import pathlib
 import re
@@ -8,6 +10,7 @@ import shutil
 import subprocess
 
 import numpy as np
+import pytest
 import yaml
 from omnislam_render.pngio import write_png_gray
 
@@ -27,11 +30,18 @@ def images(numbers):
     return [DATA / f"{n:06d}.png" for n in numbers]
 
 
-def test_calibrate_target_recovers_a_misaligned_rig(tmp_path):
-    truth = yaml.safe_load((DATA / "truth.yaml").read_text())["camera"]
-    out = tmp_path / "target.yaml"
+@pytest.fixture(scope="module")
+def calibrated(tmp_path_factory):
+    """The 24 images calibrated once (~30-45 s): the run and the YAML it wrote."""
+    out = tmp_path_factory.mktemp("target") / "target.yaml"
     result = run("calibrate", "target", *images(range(1, 25)), "--squares", "8x6", "--square-mm", "45",
                  "--out", out)
+    return result, out
+
+
+def test_calibrate_target_recovers_a_misaligned_rig(calibrated):
+    truth = yaml.safe_load((DATA / "truth.yaml").read_text())["camera"]
+    result, out = calibrated
     assert result.returncode == 0, result.stderr
     print(result.stdout)
     assert "24 used (16 on the floor, 8 held)" in result.stdout
@@ -40,22 +50,65 @@ def test_calibrate_target_recovers_a_misaligned_rig(tmp_path):
         assert f"| {name} |" in result.stdout
     assert "range error these uncertainties imply" in result.stdout
     camera = yaml.safe_load(out.read_text())["camera"]
-    # Measured (see docs/calibration.md): tilt within 0.03 deg (the issue's 0.05 holds); the
-    # centre 2.1 px, focal 0.17% and distance 0.9 mm off (the issue's 0.1 px, 0.05%, 0.1% do
-    # not hold: the centre is nearly a turn of the camera, the corners carry ~0.02 px of
-    # systematic error per image); bounds at about 1.5 times what was measured.
+    # Measured (see docs/calibration.md): focal 0.035%, mirror distance 0.22 mm = 0.08% of
+    # the 270.3 mm to the inner focus, tilt 0.008 / 0.011 deg: the issue's 0.05%, 0.1% and
+    # 0.05 deg hold and are asserted. The centre is 0.7 / 0.46 px off (sigma 0.7: the issue's
+    # 0.1 px does not hold; a centre shift is nearly a turn of the camera, which the tilt and
+    # offset absorb, see test_replay_with_the_target_calibration): bound at ~2x.
     assert abs(camera["mirror_tilt_deg"][0] - truth["mirror_tilt_deg"][0]) < 0.05
     assert abs(camera["mirror_tilt_deg"][1] - truth["mirror_tilt_deg"][1]) < 0.05
-    assert abs(camera["center_px"][0] - truth["center_px"][0]) < 3.5
-    assert abs(camera["center_px"][1] - truth["center_px"][1]) < 3.5
-    assert abs(camera["focal_scale"] / truth["focal_scale"] - 1.0) < 0.0025
-    assert abs(camera["mirror_dz_mm"] - truth["mirror_dz_mm"]) < 1.4
-    assert abs(camera["mirror_offset_mm"][0] - truth["mirror_offset_mm"][0]) < 0.3
-    assert abs(camera["mirror_offset_mm"][1] - truth["mirror_offset_mm"][1]) < 0.3
+    assert abs(camera["center_px"][0] - truth["center_px"][0]) < 1.5
+    assert abs(camera["center_px"][1] - truth["center_px"][1]) < 1.5
+    assert abs(camera["focal_scale"] / truth["focal_scale"] - 1.0) < 0.0005
+    assert abs(camera["mirror_dz_mm"] - truth["mirror_dz_mm"]) < 0.001 * 270.3
+    assert abs(camera["mirror_offset_mm"][0] - truth["mirror_offset_mm"][0]) < 0.15
+    assert abs(camera["mirror_offset_mm"][1] - truth["mirror_offset_mm"][1]) < 0.15
     # The file is a configuration: omnislam reads it back.
     scan = run("scan", images([1])[0], "--config", out, "--quiet")
     assert scan.returncode == 0, scan.stderr
     assert scan.stdout.startswith("azimuth_deg,range_m")
+
+
+def _replay(dataset, out):
+    """(max position error, map median distance to the floor plan), both in mm."""
+    replay = run("replay", dataset, "--out", out)
+    assert replay.returncode == 0, replay.stderr
+    evaluation = run("evaluate", out, dataset)
+    assert evaluation.returncode == 0, evaluation.stderr
+    result = json.loads((out / "evaluation.json").read_text())
+    return result["ate"]["max_m"] * 1000.0, result["map"]["median_distance_m"] * 1000.0
+
+
+def _with_camera(tmp_path, name, camera):
+    """datasets/sim-room-37-target-rig (sim-room-37 through this rig) with another camera."""
+    source = ROOT / "datasets" / "sim-room-37-target-rig"
+    out = tmp_path / name
+    shutil.copytree(source, out, ignore=shutil.ignore_patterns("images"))
+    (out / "images").symlink_to(source / "images")
+    line = "camera: " + json.dumps({"width": 1024, "height": 1024, "focal_mm": 25.0,
+                                    "pixel_pitch_mm": 0.0070205078125, **camera})
+    text = (out / "dataset.yaml").read_text()
+    (out / "dataset.yaml").write_text(re.sub(r"(?m)^camera: .*$", lambda _: line, text))
+    return out
+
+
+def test_replay_with_the_target_calibration(calibrated, tmp_path):
+    """The issue's acceptance: sim-room-37 seen through the same misaligned rig, replayed with
+    the parameters the boards gave, within 15% of the designed rig's run (sim-room-37).
+    Measured: designed rig 5.6 mm max / 2.7 mm map median; calibrated 6.3 / 3.1 (+12%, +12%);
+    the true parameters 7.0 / 2.3; the designed parameters 479.5 / 453.1."""
+    result, out = calibrated
+    assert result.returncode == 0, result.stderr
+    camera = yaml.safe_load(out.read_text())["camera"]
+    reference_max, reference_median = _replay(ROOT / "datasets" / "sim-room-37", tmp_path / "reference")
+    fitted_max, fitted_median = _replay(_with_camera(tmp_path, "fitted", camera), tmp_path / "fitted-run")
+    designed_max, designed_median = _replay(_with_camera(tmp_path, "designed", {"center_px": [511.5, 511.5]}),
+                                            tmp_path / "designed-run")
+    print(f"designed rig {reference_max:.1f}/{reference_median:.1f} mm, calibrated "
+          f"{fitted_max:.1f}/{fitted_median:.1f} mm, designed parameters {designed_max:.1f}/{designed_median:.1f}")
+    assert fitted_max <= 1.15 * reference_max
+    assert fitted_median <= 1.15 * reference_median
+    assert designed_max > 100.0 and designed_median > 100.0
 
 
 def test_calibrate_target_skips_an_image_without_the_board(tmp_path):

@@ -1,5 +1,6 @@
 #include "omnislam/calib/target_detect.hpp"
 
+#include <Eigen/Core>
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -7,7 +8,10 @@
 #include <numbers>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgproc.hpp>
+#include <optional>
 #include <vector>
+
+#include "corner_refine.hpp"
 
 namespace omnislam::calib {
 namespace {
@@ -144,6 +148,42 @@ std::vector<cv::Point2f> raw_corners(const Unrolled &lobe, const Grid &grid) {
   return raw;
 }
 
+// One square's step along the board's x and y at corner (x, y) of a row-major grid in the
+// image: the central difference of its neighbours, one-sided at the board's edge.
+Eigen::Matrix2d square_axes(const std::vector<cv::Point2f> &raw, int nx, int ny, int x, int y) {
+  const auto at = [&](int cx, int cy) {
+    const cv::Point2f &p = raw[static_cast<std::size_t>(cy * nx + cx)];
+    return Eigen::Vector2d(p.x, p.y);
+  };
+  const auto step = [&](int dx, int dy) -> Eigen::Vector2d {
+    const int x0 = std::max(x - dx, 0), x1 = std::min(x + dx, nx - 1);
+    const int y0 = std::max(y - dy, 0), y1 = std::min(y + dy, ny - 1);
+    return (at(x1, y1) - at(x0, y0)) / static_cast<double>(std::max(x1 - x0, y1 - y0));
+  };
+  Eigen::Matrix2d axes;
+  axes.col(0) = step(1, 0);
+  axes.col(1) = step(0, 1);
+  return axes;
+}
+
+// Each corner fitted in the raw image (corner_refine.hpp); where the fit fails the
+// detector's corner stays.
+std::vector<cv::Point2f> refined(const cv::Mat &image, std::vector<cv::Point2f> raw, int nx, int ny,
+                                 const TargetDetectConfig &config) {
+  detail::CornerRefineConfig refine;
+  refine.window = config.refine_window_squares;
+  const std::vector<cv::Point2f> detected = raw;
+  for (int y = 0; y < ny; ++y) {
+    for (int x = 0; x < nx; ++x) {
+      cv::Point2f &p = raw[static_cast<std::size_t>(y * nx + x)];
+      const std::optional<Eigen::Vector2d> corner = detail::refine_corner(
+          image, Eigen::Vector2d(p.x, p.y), square_axes(detected, nx, ny, x, y), refine);
+      if (corner) p = cv::Point2f(static_cast<float>(corner->x()), static_cast<float>(corner->y()));
+    }
+  }
+  return raw;
+}
+
 void add_corners(TargetView &view, mirror::Lobe lobe, const std::vector<cv::Point2f> &raw) {
   for (std::size_t i = 0; i < raw.size(); ++i)
     view.corners.push_back({static_cast<int>(i), lobe, {raw[i].x, raw[i].y}});
@@ -169,12 +209,16 @@ TargetDetection detect_target(const cv::Mat &image, const mirror::MirrorConfig &
   if (inner_grid) inner_grid = canonical(*inner_grid, nx, ny);
   if (outer_grid)
     outer_grid = inner_grid ? matched(*outer_grid, *inner_grid, nx, ny) : canonical(*outer_grid, nx, ny);
+  const auto corners_of = [&](const Unrolled &lobe, const Grid &grid) {
+    const std::vector<cv::Point2f> raw = raw_corners(lobe, grid);
+    return config.refine_window_squares > 0.0 ? refined(image, raw, nx, ny, config) : raw;
+  };
   if (inner_grid) {
-    add_corners(detection.view, mirror::Lobe::kInner, raw_corners(inner, *inner_grid));
+    add_corners(detection.view, mirror::Lobe::kInner, corners_of(inner, *inner_grid));
     detection.inner_corners = nx * ny;
   }
   if (outer_grid) {
-    add_corners(detection.view, mirror::Lobe::kOuter, raw_corners(outer, *outer_grid));
+    add_corners(detection.view, mirror::Lobe::kOuter, corners_of(outer, *outer_grid));
     detection.outer_corners = nx * ny;
   }
   if (!inner_grid && !outer_grid) {
