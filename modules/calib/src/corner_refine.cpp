@@ -15,22 +15,29 @@ struct Sample {
   double u, v, grey;
 };
 
-// The blurred image of a corner (corner_refine.hpp) at each sample, minus its grey level.
-// Parameters: corner (u, v), edge directions (rad), (m, k), sigma (px).
+// erf(d1 / (sqrt(2) sigma)) erf(d2 / (sqrt(2) sigma)) at (u, v): the corner's shape, which
+// the grey levels follow up to (m, k) (corner_refine.hpp). Parameters: corner (u, v), edge
+// directions (rad), sigma (px).
+template <typename T>
+T corner_shape(double u, double v, const T *corner, const T *direction, const T &sigma) {
+  using std::cos, std::erf, std::sin;
+  const T du = T(u) - corner[0], dv = T(v) - corner[1];
+  const T d1 = -sin(direction[0]) * du + cos(direction[0]) * dv;
+  const T d2 = -sin(direction[1]) * du + cos(direction[1]) * dv;
+  const T scale = sigma * T(std::numbers::sqrt2);
+  return erf(d1 / scale) * erf(d2 / scale);
+}
+
+// The blurred image of a corner at each sample, minus its grey level; `level` is (m, k).
 class CornerModel {
  public:
   explicit CornerModel(std::vector<Sample> samples) : samples_(std::move(samples)) {}
 
   template <typename T>
   bool operator()(const T *corner, const T *direction, const T *level, const T *sigma, T *residual) const {
-    using std::cos, std::erf, std::sin;
-    const T n1u = -sin(direction[0]), n1v = cos(direction[0]);
-    const T n2u = -sin(direction[1]), n2v = cos(direction[1]);
-    const T scale = sigma[0] * T(std::numbers::sqrt2);
     for (std::size_t i = 0; i < samples_.size(); ++i) {
-      const T du = T(samples_[i].u) - corner[0], dv = T(samples_[i].v) - corner[1];
-      const T d1 = n1u * du + n1v * dv, d2 = n2u * du + n2v * dv;
-      residual[i] = level[0] + level[1] * erf(d1 / scale) * erf(d2 / scale) - T(samples_[i].grey);
+      const Sample &s = samples_[i];
+      residual[i] = level[0] + level[1] * corner_shape(s.u, s.v, corner, direction, sigma[0]) - T(s.grey);
     }
     return true;
   }
@@ -61,16 +68,6 @@ std::vector<Sample> window_samples(const cv::Mat &image, const Eigen::Vector2d &
   return samples;
 }
 
-// erf * erf at a sample for the start geometry: the grey levels follow it up to (m, k),
-// which a linear fit then gives (so k starts with the sign of the corner's squares).
-double shape(const Sample &s, const double *corner, const double *direction, double sigma_px) {
-  const double du = s.u - corner[0], dv = s.v - corner[1];
-  const double d1 = -std::sin(direction[0]) * du + std::cos(direction[0]) * dv;
-  const double d2 = -std::sin(direction[1]) * du + std::cos(direction[1]) * dv;
-  const double scale = sigma_px * std::numbers::sqrt2;
-  return std::erf(d1 / scale) * std::erf(d2 / scale);
-}
-
 }  // namespace
 
 std::optional<Eigen::Vector2d> refine_corner(const cv::Mat &image, const Eigen::Vector2d &corner_px,
@@ -83,12 +80,14 @@ std::optional<Eigen::Vector2d> refine_corner(const cv::Mat &image, const Eigen::
   double corner[2] = {corner_px.x(), corner_px.y()};
   double direction[2] = {std::atan2(axes_px(1, 0), axes_px(0, 0)), std::atan2(axes_px(1, 1), axes_px(0, 1))};
   double sigma[1] = {0.7};  // a pixel's box and a little defocus
-  // (m, k) by linear least squares on the start geometry.
+  // (m, k) by linear least squares on the start geometry (so k starts with the sign of the
+  // corner's squares).
   Eigen::MatrixXd design(samples.size(), 2);
   Eigen::VectorXd grey(samples.size());
   for (std::size_t i = 0; i < samples.size(); ++i) {
     design(static_cast<Eigen::Index>(i), 0) = 1.0;
-    design(static_cast<Eigen::Index>(i), 1) = shape(samples[i], corner, direction, sigma[0]);
+    design(static_cast<Eigen::Index>(i), 1) =
+        corner_shape(samples[i].u, samples[i].v, corner, direction, sigma[0]);
     grey(static_cast<Eigen::Index>(i)) = samples[i].grey;
   }
   const Eigen::Vector2d start = design.colPivHouseholderQr().solve(grey);
