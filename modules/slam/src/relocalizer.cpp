@@ -57,6 +57,31 @@ std::optional<TrimmedIcpResult> Relocalizer::refine(const Points2 &scan_base,
   return fit;
 }
 
+std::vector<Relocalizer::Hypothesis> Relocalizer::rivals(const Points2 &scan_base,
+                                                         const std::vector<PoseCandidate> &candidates,
+                                                         const Hypothesis &survivor, double margin) const {
+  double best = 0.0;
+  for (const PoseCandidate &candidate : candidates) best = std::max(best, candidate.score);
+  const double own = log_likelihood(scan_base, survivor.T_map_base);
+  std::vector<Hypothesis> found;
+  const auto known = [&](const Eigen::Isometry2d &pose) {
+    return same_pose(pose, survivor.T_map_base) ||
+           std::any_of(found.begin(), found.end(),
+                       [&](const Hypothesis &h) { return same_pose(h.T_map_base, pose); });
+  };
+  for (const PoseCandidate &candidate : candidates) {
+    if (known(candidate.T_map_base)) continue;
+    const auto refined = refine(scan_base, candidate.T_map_base);
+    if (!refined || known(refined->T_model_sample)) continue;
+    const double score = matcher_.score(scan_base, refined->T_model_sample);
+    if (score < config_.min_score || score < config_.relative_score * best) continue;
+    const double behind = own - log_likelihood(scan_base, refined->T_model_sample);
+    if (behind > margin) continue;
+    found.push_back({refined->T_model_sample, refined->robust_covariance, score, std::max(behind, 0.0), 1});
+  }
+  return found;
+}
+
 LocalizationResult Relocalizer::process(const Points2 &scan_base,
                                         const std::optional<Eigen::Isometry2d> &T_odom_base,
                                         const std::optional<SearchWindow> &window) {
@@ -115,7 +140,9 @@ LocalizationResult Relocalizer::process(const Points2 &scan_base,
   }
   // 4. Every other candidate is a new hypothesis, with no history, unless the coarse grid
   //    already puts it out of the running (no refinement for those: in a building of alike
-  //    rooms most candidates are).
+  //    rooms most candidates are). A candidate at a hypothesis's place is that hypothesis:
+  //    it moves there when that explains the scan better (a hypothesis carried along a
+  //    corridor slides where the scan cannot hold it; the search finds the place again).
   const double margin = std::log((1.0 - config_.error_rate) / config_.error_rate);
   std::vector<double> coarse_log_likelihood;
   double coarse_best = -std::numeric_limits<double>::infinity();
@@ -129,17 +156,28 @@ LocalizationResult Relocalizer::process(const Points2 &scan_base,
   for (std::size_t c = 0; c < candidates.size(); ++c) {
     const PoseCandidate &candidate = candidates[c];
     if (coarse_best - coarse_log_likelihood[c] > margin) continue;
-    const auto known = [&](const Eigen::Isometry2d &pose) {
-      return std::any_of(alive.begin(), alive.end(),
-                         [&](const Hypothesis &h) { return same_pose(h.T_map_base, pose); });
-    };
-    if (known(candidate.T_map_base)) continue;
     const auto refined = refine(scan_base, candidate.T_map_base);
-    if (!refined || known(refined->T_model_sample)) continue;
-    const double score = matcher_.score(scan_base, refined->T_model_sample);
+    if (!refined) continue;
+    const Eigen::Isometry2d &pose = refined->T_model_sample;
+    const double score = matcher_.score(scan_base, pose);
+    const double likelihood = log_likelihood(scan_base, pose);
+    const auto known = std::find_if(alive.begin(), alive.end(), [&](const Hypothesis &h) {
+      return same_pose(h.T_map_base, pose) || same_pose(h.T_map_base, candidate.T_map_base);
+    });
+    if (known != alive.end()) {
+      const auto i = static_cast<std::size_t>(known - alive.begin());
+      if (likelihood > frame_log_likelihood[i] ||
+          (likelihood == frame_log_likelihood[i] && score > known->score)) {
+        known->T_map_base = pose;
+        known->covariance = refined->robust_covariance;
+        known->score = score;
+        frame_log_likelihood[i] = likelihood;
+      }
+      continue;
+    }
     if (!admissible(score)) continue;
-    alive.push_back({refined->T_model_sample, refined->robust_covariance, score, 0.0, 1});
-    frame_log_likelihood.push_back(log_likelihood(scan_base, refined->T_model_sample));
+    alive.push_back({pose, refined->robust_covariance, score, 0.0, 1});
+    frame_log_likelihood.push_back(likelihood);
   }
   // Each hypothesis falls behind the frame's best by what this frame says (a new one: by
   // this frame alone); the leader is at zero, and who trails by the decision margin is out.
@@ -157,10 +195,21 @@ LocalizationResult Relocalizer::process(const Points2 &scan_base,
     if (hypothesis.deficit <= margin) hypotheses_.push_back(hypothesis);
   }
 
-  // 5. Localized when one hypothesis alone has held for confirm_frames frames.
+  // 5. Localized when one hypothesis alone has held for confirm_frames frames, and no
+  //    other pose explains this frame's scan within the margin: the coarse grid above
+  //    left candidates unrefined, among them at times the true pose beside a wrong
+  //    corridor; before a pose is reported they are all refined. Those that pass join
+  //    as hypotheses, and the confirmation waits.
+  const auto confirmable = [&] {
+    return hypotheses_.size() == 1 && hypotheses_.front().frames >= config_.confirm_frames;
+  };
+  if (confirmable()) {
+    for (Hypothesis &rival : rivals(scan_base, candidates, hypotheses_.front(), margin))
+      hypotheses_.push_back(rival);
+  }
   result.hypotheses = static_cast<int>(hypotheses_.size());
   result.best_score = best;
-  if (hypotheses_.size() == 1 && hypotheses_.front().frames >= config_.confirm_frames) {
+  if (confirmable()) {
     localized_ = hypotheses_.front();
     result.state = LocalizationState::kLocalized;
     result.T_map_base = localized_->T_map_base;

@@ -14,9 +14,10 @@
 /// it is reported. Every frame, the whole map (or the window) is searched by correlative
 /// matching; each pose that explains the scan nearly as well as the best one is a
 /// hypothesis, refined by Trimmed ICP and carried to the next frame by odometry. A pose is
-/// reported only when one hypothesis alone has survived confirm_frames frames: in a
-/// symmetric room two hypotheses survive forever, and the robot is never localized on the
-/// wrong one of them. Not thread-safe: one instance, fed frames in order.
+/// reported only when one hypothesis alone has survived confirm_frames frames and no other
+/// candidate of the frame, refined, explains the scan nearly as well: in a symmetric room
+/// two hypotheses survive forever, and the robot is never localized on the wrong one of
+/// them. Not thread-safe: one instance, fed frames in order.
 
 namespace omnislam::slam {
 
@@ -101,6 +102,12 @@ class Relocalizer {
   [[nodiscard]] std::optional<TrimmedIcpResult> refine(const Points2 &scan_base,
                                                        const Eigen::Isometry2d &guess) const;
   [[nodiscard]] bool same_pose(const Eigen::Isometry2d &a, const Eigen::Isometry2d &b) const;
+  /// Before `survivor` is reported: every candidate of the frame at another place, refined,
+  /// that explains the scan within `margin` of it (as new hypotheses, each behind by what
+  /// this frame says).
+  [[nodiscard]] std::vector<Hypothesis> rivals(const Points2 &scan_base,
+                                               const std::vector<PoseCandidate> &candidates,
+                                               const Hypothesis &survivor, double margin) const;
 
   RelocalizerConfig config_;
   CorrelativeMatcher matcher_;
