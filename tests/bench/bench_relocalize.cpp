@@ -4,6 +4,7 @@
 // hypothesis) on one thread. Default: the bundled rooms.
 #include <algorithm>
 #include <cstdio>
+#include <cstdlib>
 #include <string>
 #include <vector>
 
@@ -72,8 +73,19 @@ void building_row(int side) {
 }  // namespace
 
 int main(int argc, char **argv) {
-  std::vector<std::string> datasets(argv + 1, argv + argc);
-  if (datasets.empty()) {
+  // [--frames N] [DATASET_DIR...]: each start gets N frames (10) to localize.
+  std::vector<std::string> datasets;
+  int max_frames = 10;
+  for (int i = 1; i < argc; ++i) {
+    const std::string arg = argv[i];
+    if (arg == "--frames" && i + 1 < argc) {
+      max_frames = std::max(1, std::atoi(argv[++i]));
+    } else {
+      datasets.push_back(arg);
+    }
+  }
+  const bool defaults = datasets.empty();
+  if (defaults) {
     for (const char *name : {"sim-room-37", "sim-room-turning", "l-room-1lap", "office-real"})
       datasets.push_back(std::string(OMNISLAM_DEFAULT_DATASETS) + "/" + name);
   }
@@ -83,7 +95,7 @@ int main(int argc, char **argv) {
   std::printf("|---|---|---|---|---|---|\n");
   for (const std::string &dir : datasets) {
     const auto run = omnislam::test::build_localization_run(dir);
-    const auto outcome = omnislam::test::relocalize_from_every_frame(run, 10);
+    const auto outcome = omnislam::test::relocalize_from_every_frame(run, max_frames);
     std::printf("| %s | %zu | %d | %d (%d / %d) | %.1f | %.1f / %.1f / %.1f |\n",
                 dir.substr(dir.find_last_of('/') + 1).c_str(), run.map.size(), outcome.starts,
                 outcome.localized, outcome.correct, outcome.wrong,
@@ -91,7 +103,7 @@ int main(int argc, char **argv) {
                 quantile(outcome.frame_ms, 0.5), quantile(outcome.frame_ms, 0.99),
                 quantile(outcome.frame_ms, 1.0));
   }
-  if (argc == 1) {
+  if (defaults) {
     for (const int side : {4, 8}) building_row(side);
   }
   return 0;

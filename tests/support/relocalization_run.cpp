@@ -1,5 +1,6 @@
 #include "relocalization_run.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -42,9 +43,14 @@ LocalizationRun build_localization_run(const std::filesystem::path &dir) {
 }
 
 RelocalizationOutcome relocalize_from_every_frame(const LocalizationRun &run, int max_frames) {
+  return relocalize_from_frames(run, max_frames, 0, static_cast<int>(run.scans.size()));
+}
+
+RelocalizationOutcome relocalize_from_frames(const LocalizationRun &run, int max_frames, int first,
+                                             int last) {
   RelocalizationOutcome outcome;
   const int frames = static_cast<int>(run.scans.size());
-  for (int start = 0; start + max_frames <= frames; ++start) {
+  for (int start = std::max(first, 0); start < last && start + max_frames <= frames; ++start) {
     slam::Relocalizer relocalizer(run.map);
     ++outcome.starts;
     for (int f = start; f < start + max_frames; ++f) {

@@ -41,4 +41,8 @@ struct RelocalizationOutcome {
 /// it those frames until it reports a pose.
 [[nodiscard]] RelocalizationOutcome relocalize_from_every_frame(const LocalizationRun &run, int max_frames);
 
+/// The same for the starts at frames [first, last) only (0-based).
+[[nodiscard]] RelocalizationOutcome relocalize_from_frames(const LocalizationRun &run, int max_frames,
+                                                           int first, int last);
+
 }  // namespace omnislam::test

@@ -48,6 +48,11 @@ double Relocalizer::log_likelihood(const Points2 &scan_base, const Eigen::Isomet
          std::log(config_.outlier_share);
 }
 
+double Relocalizer::decision_margin(std::size_t competitors) const {
+  return std::log((1.0 - config_.error_rate) / config_.error_rate) +
+         std::log(static_cast<double>(std::max<std::size_t>(competitors, 1)));
+}
+
 std::optional<TrimmedIcpResult> Relocalizer::refine(const Points2 &scan_base,
                                                     const Eigen::Isometry2d &guess) const {
   const TrimmedIcpResult fit = register_trimmed_icp(map_index_, scan_base, guess, config_.icp);
@@ -143,7 +148,7 @@ LocalizationResult Relocalizer::process(const Points2 &scan_base,
   //    rooms most candidates are). A candidate at a hypothesis's place is that hypothesis:
   //    it moves there when that explains the scan better (a hypothesis carried along a
   //    corridor slides where the scan cannot hold it; the search finds the place again).
-  const double margin = std::log((1.0 - config_.error_rate) / config_.error_rate);
+  const double margin = decision_margin(candidates.size() + hypotheses_.size());
   std::vector<double> coarse_log_likelihood;
   double coarse_best = -std::numeric_limits<double>::infinity();
   for (const PoseCandidate &candidate : candidates) {

@@ -38,7 +38,8 @@ struct RelocalizerConfig {
   /// probability outlier_share, not (the front-end's wrong points and what changed since the
   /// map: 5-10% of a scan, measured); neighbouring points share errors, so a frame's sum
   /// counts point_correlation of its points. A hypothesis falls behind the best by more than
-  /// ln((1 - error_rate) / error_rate) and is dropped (Wald's test at error_rate).
+  /// ln((1 - error_rate) / error_rate) + ln(hypotheses and candidates in play) and is
+  /// dropped (Wald's test at error_rate for the frame as a whole; decision_margin()).
   double outlier_share = 0.1;
   double point_correlation = 0.5;
   double error_rate = 0.01;
@@ -102,6 +103,12 @@ class Relocalizer {
   [[nodiscard]] std::optional<TrimmedIcpResult> refine(const Points2 &scan_base,
                                                        const Eigen::Isometry2d &guess) const;
   [[nodiscard]] bool same_pose(const Eigen::Isometry2d &a, const Eigen::Isometry2d &b) const;
+  /// Log-likelihood by which a hypothesis may trail the best before it is dropped: Wald's
+  /// ln((1 - error_rate) / error_rate), plus ln(competitors). The true pose is dropped when
+  /// any one of the frame's other poses gets that far ahead of it by chance; with N of them
+  /// in play each must be held to error_rate / N for the frame to keep error_rate
+  /// (Bonferroni). A corridor offers dozens of alike poses, a room a handful.
+  [[nodiscard]] double decision_margin(std::size_t competitors) const;
   /// Before `survivor` is reported: every candidate of the frame at another place, refined,
   /// that explains the scan within `margin` of it (as new hypotheses, each behind by what
   /// this frame says).
