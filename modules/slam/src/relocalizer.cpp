@@ -37,8 +37,7 @@ bool Relocalizer::same_pose(const Eigen::Isometry2d &a, const Eigen::Isometry2d 
              config_.distinct_rad;
 }
 
-double Relocalizer::log_likelihood(const Points2 &scan_base, const Eigen::Isometry2d &T_map_base) const {
-  const Points2 thinned = matcher_.thinned(scan_base);
+double Relocalizer::log_likelihood(const Points2 &thinned, const Eigen::Isometry2d &T_map_base) const {
   const double reach_m = 2.0 * matcher_.config().sigma_m;
   const auto explained =
       static_cast<double>(std::count_if(thinned.begin(), thinned.end(), [&](const Point2 &p) {
@@ -46,6 +45,10 @@ double Relocalizer::log_likelihood(const Points2 &scan_base, const Eigen::Isomet
       }));
   return config_.point_correlation * (static_cast<double>(thinned.size()) - explained) *
          std::log(config_.outlier_share);
+}
+
+bool Relocalizer::admissible(double score, double best_score) const {
+  return score >= config_.min_score && score >= config_.relative_score * best_score;
 }
 
 double Relocalizer::decision_margin(std::size_t competitors) const {
@@ -62,12 +65,11 @@ std::optional<TrimmedIcpResult> Relocalizer::refine(const Points2 &scan_base,
   return fit;
 }
 
-std::vector<Relocalizer::Hypothesis> Relocalizer::rivals(const Points2 &scan_base,
+std::vector<Relocalizer::Hypothesis> Relocalizer::rivals(const Points2 &scan_base, const Points2 &thinned,
                                                          const std::vector<PoseCandidate> &candidates,
-                                                         const Hypothesis &survivor, double margin) const {
-  double best = 0.0;
-  for (const PoseCandidate &candidate : candidates) best = std::max(best, candidate.score);
-  const double own = log_likelihood(scan_base, survivor.T_map_base);
+                                                         double candidates_best, const Hypothesis &survivor,
+                                                         double margin) const {
+  const double own = log_likelihood(thinned, survivor.T_map_base);
   std::vector<Hypothesis> found;
   const auto known = [&](const Eigen::Isometry2d &pose) {
     return same_pose(pose, survivor.T_map_base) ||
@@ -79,8 +81,8 @@ std::vector<Relocalizer::Hypothesis> Relocalizer::rivals(const Points2 &scan_bas
     const auto refined = refine(scan_base, candidate.T_map_base);
     if (!refined || known(refined->T_model_sample)) continue;
     const double score = matcher_.score(scan_base, refined->T_model_sample);
-    if (score < config_.min_score || score < config_.relative_score * best) continue;
-    const double behind = own - log_likelihood(scan_base, refined->T_model_sample);
+    if (!admissible(score, candidates_best)) continue;
+    const double behind = own - log_likelihood(thinned, refined->T_model_sample);
     if (behind > margin) continue;
     found.push_back({refined->T_model_sample, refined->robust_covariance, score, std::max(behind, 0.0), 1});
   }
@@ -123,13 +125,13 @@ LocalizationResult Relocalizer::process(const Points2 &scan_base,
   const std::vector<PoseCandidate> candidates = search_matcher_.search(
       scan_base, config_.min_score, config_.relative_score, config_.distinct_m, config_.distinct_rad, window);
   result.searched_poses = static_cast<int>(candidates.size());
-  double best = 0.0;
-  for (const PoseCandidate &candidate : candidates) best = std::max(best, candidate.score);
+  double candidates_best = 0.0;
+  for (const PoseCandidate &candidate : candidates)
+    candidates_best = std::max(candidates_best, candidate.score);
+  double best = candidates_best;                        // ... and of the hypotheses kept (reported)
+  const Points2 thinned = matcher_.thinned(scan_base);  // what the likelihoods count
 
   // 3. A tracked hypothesis survives where its refined pose still explains the scan.
-  const auto admissible = [&](double score) {
-    return score >= config_.min_score && score >= config_.relative_score * best;
-  };
   std::vector<Hypothesis> alive;
   std::vector<double> frame_log_likelihood;
   for (Hypothesis hypothesis : hypotheses_) {
@@ -141,7 +143,7 @@ LocalizationResult Relocalizer::process(const Points2 &scan_base,
     if (hypothesis.score < config_.min_score) continue;
     ++hypothesis.frames;
     alive.push_back(hypothesis);
-    frame_log_likelihood.push_back(log_likelihood(scan_base, hypothesis.T_map_base));
+    frame_log_likelihood.push_back(log_likelihood(thinned, hypothesis.T_map_base));
   }
   // 4. Every other candidate is a new hypothesis, with no history, unless the coarse grid
   //    already puts it out of the running (no refinement for those: in a building of alike
@@ -165,7 +167,7 @@ LocalizationResult Relocalizer::process(const Points2 &scan_base,
     if (!refined) continue;
     const Eigen::Isometry2d &pose = refined->T_model_sample;
     const double score = matcher_.score(scan_base, pose);
-    const double likelihood = log_likelihood(scan_base, pose);
+    const double likelihood = log_likelihood(thinned, pose);
     const auto known = std::find_if(alive.begin(), alive.end(), [&](const Hypothesis &h) {
       return same_pose(h.T_map_base, pose) || same_pose(h.T_map_base, candidate.T_map_base);
     });
@@ -180,7 +182,7 @@ LocalizationResult Relocalizer::process(const Points2 &scan_base,
       }
       continue;
     }
-    if (!admissible(score)) continue;
+    if (!admissible(score, candidates_best)) continue;
     alive.push_back({pose, refined->robust_covariance, score, 0.0, 1});
     frame_log_likelihood.push_back(likelihood);
   }
@@ -209,7 +211,8 @@ LocalizationResult Relocalizer::process(const Points2 &scan_base,
     return hypotheses_.size() == 1 && hypotheses_.front().frames >= config_.confirm_frames;
   };
   if (confirmable()) {
-    for (Hypothesis &rival : rivals(scan_base, candidates, hypotheses_.front(), margin))
+    for (Hypothesis &rival :
+         rivals(scan_base, thinned, candidates, candidates_best, hypotheses_.front(), margin))
       hypotheses_.push_back(rival);
   }
   result.hypotheses = static_cast<int>(hypotheses_.size());

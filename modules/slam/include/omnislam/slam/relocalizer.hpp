@@ -98,11 +98,15 @@ class Relocalizer {
   /// only by sub-sigma fit quality, and the grid's bilinear score (off by up to ~20% with
   /// where the map's points fall between cells) turned that noise into evidence, enough to
   /// drop the true pose beside a wrong corridor in three frames.
-  [[nodiscard]] double log_likelihood(const Points2 &scan_base, const Eigen::Isometry2d &T_map_base) const;
+  /// `thinned`: the scan as matcher_.thinned() gives it (once per frame).
+  [[nodiscard]] double log_likelihood(const Points2 &thinned, const Eigen::Isometry2d &T_map_base) const;
   /// ICP from `guess` against the map; nullopt when the fit is rejected.
   [[nodiscard]] std::optional<TrimmedIcpResult> refine(const Points2 &scan_base,
                                                        const Eigen::Isometry2d &guess) const;
   [[nodiscard]] bool same_pose(const Eigen::Isometry2d &a, const Eigen::Isometry2d &b) const;
+  /// A refined pose's score qualifies it as a hypothesis: min_score, and relative_score of
+  /// the frame's best search candidate.
+  [[nodiscard]] bool admissible(double score, double best_score) const;
   /// Log-likelihood by which a hypothesis may trail the best before it is dropped: Wald's
   /// ln((1 - error_rate) / error_rate), plus ln(competitors). The true pose is dropped when
   /// any one of the frame's other poses gets that far ahead of it by chance; with N of them
@@ -112,9 +116,10 @@ class Relocalizer {
   /// Before `survivor` is reported: every candidate of the frame at another place, refined,
   /// that explains the scan within `margin` of it (as new hypotheses, each behind by what
   /// this frame says).
-  [[nodiscard]] std::vector<Hypothesis> rivals(const Points2 &scan_base,
+  [[nodiscard]] std::vector<Hypothesis> rivals(const Points2 &scan_base, const Points2 &thinned,
                                                const std::vector<PoseCandidate> &candidates,
-                                               const Hypothesis &survivor, double margin) const;
+                                               double candidates_best, const Hypothesis &survivor,
+                                               double margin) const;
 
   RelocalizerConfig config_;
   CorrelativeMatcher matcher_;
