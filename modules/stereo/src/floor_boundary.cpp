@@ -1,6 +1,7 @@
 #include "omnislam/stereo/floor_boundary.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -205,20 +206,22 @@ float FloorBoundaryFinder::window_deviation(int inner_row, int column,
 }
 
 float FloorBoundaryFinder::row_vote(float residual_against, float residual_for) const {
+  const float difference = (residual_against - residual_for) / noise_scale_;
+  const float vote =
+      std::copysign(std::min(std::max(0.0f, std::abs(difference) - kDeadZone), kMaxRowVote), difference);
   // A row neither hypothesis explains (a dust speck, a highlight, a third surface in
   // between) is an outlier under both: it says nothing about which is right.
-  if (std::min(residual_against, residual_for) > kOutlierResidual * noise_scale_) return 0.0f;
-  const float difference = (residual_against - residual_for) / noise_scale_;
-  return std::clamp(std::copysign(std::max(0.0f, std::abs(difference) - kDeadZone), difference), -kMaxRowVote,
-                    kMaxRowVote);
+  return std::min(residual_against, residual_for) > kOutlierResidual * noise_scale_ ? 0.0f : vote;
 }
 
 FloorBoundaryFinder::Verdict FloorBoundaryFinder::floor_or_vertical(int column, float edge_row,
                                                                     float contact_row) const {
   // Wald's sequential test, rows outwards from the edge. Rows inside the edge's own blur,
   // in either lobe, measure the sub-pixel placement of a steep edge rather than the
-  // hypotheses, and do not vote. (The walk is the front-end's hottest loop: the column's
-  // lines and the two tabulated bases around the edge are looked up once.)
+  // hypotheses, and do not vote. (The walk is the front-end's hottest loop, some 60 rows a
+  // call on a textured floor: the votes of a block of rows are computed together, branch
+  // free so that the compiler vectorises them, and then summed in order until a decision;
+  // a row that does not vote adds 0.)
   const int base = static_cast<int>(edge_row);
   if (base + 1 >= rows_) return Verdict::kUndecided;  // no surface tabulated that far
   const float fraction = edge_row - static_cast<float>(base);
@@ -227,20 +230,33 @@ FloorBoundaryFinder::Verdict FloorBoundaryFinder::floor_or_vertical(int column, 
   const float *floor_residual = floor_residual_.ptr<float>(column);
   const float *inner = inner_.ptr<float>(column);
   const float *outer = outer_.ptr<float>(column);
+  constexpr int kBlock = 16;
+  std::array<float, kBlock> votes{};
   double llr = 0.0;
-  for (int row = base - kEdgeBlurRows; row >= 0; --row) {
-    const float vertical_row = near_base[row] + fraction * (far_base[row] - near_base[row]);
-    if (!std::isfinite(floor_residual[row]) || !std::isfinite(vertical_row)) continue;
-    if (std::abs(vertical_row - contact_row) <= kEdgeBlurRows) continue;
-    const float vertical_residual =
-        std::abs(inner[row] - gain(row, vertical_row) * interpolate(outer, vertical_row));
-    // Laplace log-likelihood ratio of the row, less a dead zone: two residuals of independent
-    // noise differ by up to about twice the scale, and what the model itself leaves (sub-pixel
-    // base, interpolation, the gain estimate) is smaller still; neither must add up over a
-    // long uniform wall as if it were evidence.
-    llr += kRowCorrelation * row_vote(vertical_residual, floor_residual[row]);
-    if (llr >= decision_llr_) return Verdict::kFloor;
-    if (llr <= -decision_llr_) return Verdict::kVertical;
+  for (int top = base - kEdgeBlurRows; top >= 0; top -= kBlock) {
+    const int first = std::max(0, top - kBlock + 1), count = top - first + 1;
+    for (int i = 0; i < count; ++i) {
+      const int row = first + i;
+      const float vertical_row = near_base[row] + fraction * (far_base[row] - near_base[row]);
+      const float floor_row_residual = floor_residual[row];
+      const bool votes_here = std::isfinite(floor_row_residual) & std::isfinite(vertical_row) &
+                              (std::abs(vertical_row - contact_row) > kEdgeBlurRows);
+      // (Row 0 stands in for the surface's outer row where the row does not vote.)
+      const float surface_row = votes_here ? vertical_row : 0.0f;
+      const float vertical_residual =
+          std::abs(inner[row] - gain(row, surface_row) * interpolate(outer, surface_row));
+      // Laplace log-likelihood ratio of the row, less a dead zone: two residuals of independent
+      // noise differ by up to about twice the scale, and what the model itself leaves (sub-pixel
+      // base, interpolation, the gain estimate) is smaller still; neither must add up over a
+      // long uniform wall as if it were evidence.
+      const float vote = row_vote(vertical_residual, floor_row_residual);
+      votes[static_cast<std::size_t>(i)] = votes_here ? vote : 0.0f;
+    }
+    for (int i = count - 1; i >= 0; --i) {
+      llr += kRowCorrelation * votes[static_cast<std::size_t>(i)];
+      if (llr >= decision_llr_) return Verdict::kFloor;
+      if (llr <= -decision_llr_) return Verdict::kVertical;
+    }
   }
   return Verdict::kUndecided;
 }
