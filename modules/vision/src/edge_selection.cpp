@@ -1,8 +1,10 @@
 #include "omnislam/vision/edge_selection.hpp"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <vector>
 
 namespace omnislam::vision {
@@ -12,11 +14,10 @@ int abs_row_gradient(const cv::Mat &grad_row, int row, int column) {
   return std::abs(static_cast<int>(grad_row.at<std::int16_t>(row, column)));
 }
 
-// An edge pixel whose gradient points mostly along the column.
-bool is_horizontal(std::int16_t grad_row, std::int16_t grad_col, double ratio) {
-  const double along = std::abs(static_cast<double>(grad_row));
-  const double across = std::abs(static_cast<double>(grad_col));
-  return along >= ratio * across && along > 0.0;
+// The byte (in memory order) of a word's lowest set bit.
+int byte_of_lowest_bit(std::uint64_t word) {
+  const int byte = std::countr_zero(word) / 8;
+  return std::endian::native == std::endian::little ? byte : 7 - byte;
 }
 
 // Vertex of the parabola through (-1, a), (0, b), (1, c), clamped to half a pixel.
@@ -80,12 +81,16 @@ SelectionStats select_nearest_horizontal_edges(const EdgeImage &edges, const cv:
   out.reset(columns, config.max_edges_per_column);
   // Every column is read bottom-up (the bottom rows are the points nearest the robot,
   // mirror.md sec. 0), but all columns advance together, one image row at a time: walking
-  // one column at a time would touch a new cache line per pixel.
+  // one column at a time would touch a new cache line per pixel. A run of consecutive
+  // horizontal edge pixels is represented by its strongest pixel (the nearest one on ties),
+  // if that is a local maximum along the column. Each row first updates every column's
+  // open run without a branch (a textured floor's edges are random, and a branch per pixel
+  // mispredicts), then closes the runs that ended there.
   constexpr int kNoRun = -1;
   std::vector<int> run_peak(static_cast<std::size_t>(columns), kNoRun);
+  std::vector<int> run_strength(static_cast<std::size_t>(columns), 0);
   std::vector<int> kept(static_cast<std::size_t>(columns), 0);
-  // A run of consecutive horizontal edge pixels is represented by its strongest pixel
-  // (the nearest one on ties), if that is a local maximum along the column.
+  std::vector<std::uint8_t> closing(static_cast<std::size_t>(columns), 0);
   const auto close_run = [&](int column) {
     int &peak = run_peak[static_cast<std::size_t>(column)];
     const int above = abs_row_gradient(edges.grad_row, peak - 1, column);
@@ -107,26 +112,42 @@ SelectionStats select_nearest_horizontal_edges(const EdgeImage &edges, const cv:
     out.push(column, {row, static_cast<float>(row) + offset, static_cast<float>(centre)});
     ++kept[static_cast<std::size_t>(column)];
   };
+  const int max_kept = config.max_edges_per_column;
+  const double ratio = config.horizontal_ratio;
+  int *peaks = run_peak.data(), *strengths = run_strength.data(), *kept_here = kept.data();
+  std::uint8_t *ends = closing.data();
   for (int row = rows - 1 - margin; row >= margin; --row) {
     const auto *edge = edges.edges.ptr<std::uint8_t>(row);
     const auto *along = edges.grad_row.ptr<std::int16_t>(row);
     const auto *across = edges.grad_col.ptr<std::int16_t>(row);
+    int horizontal_px = 0, runs = 0;
     for (int column = 0; column < columns; ++column) {
-      int &peak = run_peak[static_cast<std::size_t>(column)];
+      // An edge pixel whose gradient points mostly along the column.
+      const int strength = std::abs(static_cast<int>(along[column]));
+      const double across_strength = std::abs(static_cast<double>(across[column]));
       const bool horizontal =
-          edge[column] != 0 && is_horizontal(along[column], across[column], config.horizontal_ratio);
-      if (!horizontal) {
-        if (peak != kNoRun) close_run(column);
-        continue;
-      }
-      if (kept[static_cast<std::size_t>(column)] >= config.max_edges_per_column) continue;
-      ++stats.horizontal_px;
-      if (peak == kNoRun) {
-        ++stats.runs;
-        peak = row;
-      } else if (std::abs(static_cast<int>(along[column])) > abs_row_gradient(edges.grad_row, peak, column)) {
-        peak = row;
-      }
+          (edge[column] != 0) & (strength > 0) & (static_cast<double>(strength) >= ratio * across_strength);
+      const bool open = peaks[column] != kNoRun;
+      // A full column takes no more runs; an open run ends at a pixel that is not horizontal.
+      const bool counted = horizontal & (kept_here[column] < max_kept);
+      const bool new_peak = counted & (!open | (strength > strengths[column]));
+      ends[column] = static_cast<std::uint8_t>(!horizontal & open);
+      horizontal_px += static_cast<int>(counted);
+      runs += static_cast<int>(counted & !open);
+      peaks[column] = new_peak ? row : peaks[column];
+      strengths[column] = new_peak ? strength : strengths[column];
+    }
+    stats.horizontal_px += horizontal_px;
+    stats.runs += runs;
+    // Few runs end in any one row: skip eight columns at a time where none does.
+    int column = 0;
+    for (; column + 8 <= columns; column += 8) {
+      std::uint64_t word = 0;
+      std::memcpy(&word, ends + column, sizeof word);
+      for (; word != 0; word &= word - 1) close_run(column + byte_of_lowest_bit(word));
+    }
+    for (; column < columns; ++column) {
+      if (ends[column] != 0) close_run(column);
     }
   }
   for (int column = 0; column < columns; ++column) {
