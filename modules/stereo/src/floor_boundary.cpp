@@ -239,8 +239,10 @@ FloorBoundaryFinder::Verdict FloorBoundaryFinder::floor_or_vertical(int column, 
       const int row = first + i;
       const float vertical_row = near_base[row] + fraction * (far_base[row] - near_base[row]);
       const float floor_row_residual = floor_residual[row];
-      const bool votes_here = std::isfinite(floor_row_residual) & std::isfinite(vertical_row) &
-                              (std::abs(vertical_row - contact_row) > kEdgeBlurRows);
+      // Bitwise on ints, not &&: no branch, so the block stays vectorised.
+      const bool votes_here = (static_cast<int>(std::isfinite(floor_row_residual)) &
+                               static_cast<int>(std::isfinite(vertical_row)) &
+                               static_cast<int>(std::abs(vertical_row - contact_row) > kEdgeBlurRows)) != 0;
       // (Row 0 stands in for the surface's outer row where the row does not vote.)
       const float surface_row = votes_here ? vertical_row : 0.0f;
       const float vertical_residual =
