@@ -94,7 +94,7 @@ SelectionStats select_nearest_horizontal_edges(const EdgeImage &edges, const cv:
   const auto close_run = [&](int column) {
     int &peak = run_peak[static_cast<std::size_t>(column)];
     const int above = abs_row_gradient(edges.grad_row, peak - 1, column);
-    const int centre = abs_row_gradient(edges.grad_row, peak, column);
+    const int centre = run_strength[static_cast<std::size_t>(column)];  // |d/d(row)| at the peak
     const int below = abs_row_gradient(edges.grad_row, peak + 1, column);
     const int row = peak;
     peak = kNoRun;
