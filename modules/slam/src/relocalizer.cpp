@@ -131,7 +131,11 @@ LocalizationResult Relocalizer::process(const Points2 &scan_base,
   double best = candidates_best;                        // ... and of the hypotheses kept (reported)
   const Points2 thinned = matcher_.thinned(scan_base);  // what the likelihoods count
 
-  // 3. A tracked hypothesis survives where its refined pose still explains the scan.
+  // 3. A tracked hypothesis survives where its refined pose still explains the scan. Two
+  //    that the refinement brings to one place (along a corridor, where ICP slides) are one
+  //    hypothesis from then on: the one with the better record (visited first) stays.
+  std::stable_sort(hypotheses_.begin(), hypotheses_.end(),
+                   [](const Hypothesis &a, const Hypothesis &b) { return a.deficit < b.deficit; });
   std::vector<Hypothesis> alive;
   std::vector<double> frame_log_likelihood;
   for (Hypothesis hypothesis : hypotheses_) {
@@ -141,6 +145,10 @@ LocalizationResult Relocalizer::process(const Points2 &scan_base,
     hypothesis.covariance = refined->robust_covariance;
     hypothesis.score = matcher_.score(scan_base, hypothesis.T_map_base);
     if (hypothesis.score < config_.min_score) continue;
+    if (std::any_of(alive.begin(), alive.end(), [&](const Hypothesis &kept) {
+          return same_pose(kept.T_map_base, hypothesis.T_map_base);
+        }))
+      continue;
     ++hypothesis.frames;
     alive.push_back(hypothesis);
     frame_log_likelihood.push_back(log_likelihood(thinned, hypothesis.T_map_base));

@@ -13,7 +13,8 @@
 /// start pose, or a rough one as a search window), and confirmed over several frames before
 /// it is reported. Every frame, the whole map (or the window) is searched by correlative
 /// matching; each pose that explains the scan nearly as well as the best one is a
-/// hypothesis, refined by Trimmed ICP and carried to the next frame by odometry. A pose is
+/// hypothesis, refined by Trimmed ICP and carried to the next frame by odometry (two that the
+/// refinement brings to one place are one hypothesis from then on). A pose is
 /// reported only when one hypothesis alone has survived confirm_frames frames and no other
 /// candidate of the frame, refined, explains the scan nearly as well: in a symmetric room
 /// two hypotheses survive forever, and the robot is never localized on the wrong one of
