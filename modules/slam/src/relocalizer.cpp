@@ -141,14 +141,14 @@ LocalizationResult Relocalizer::process(const Points2 &scan_base,
   for (Hypothesis hypothesis : hypotheses_) {
     const auto refined = refine(scan_base, hypothesis.T_map_base);
     if (!refined) continue;
+    if (std::any_of(alive.begin(), alive.end(), [&](const Hypothesis &kept) {
+          return same_pose(kept.T_map_base, refined->T_model_sample);
+        }))
+      continue;
     hypothesis.T_map_base = refined->T_model_sample;
     hypothesis.covariance = refined->robust_covariance;
     hypothesis.score = matcher_.score(scan_base, hypothesis.T_map_base);
     if (hypothesis.score < config_.min_score) continue;
-    if (std::any_of(alive.begin(), alive.end(), [&](const Hypothesis &kept) {
-          return same_pose(kept.T_map_base, hypothesis.T_map_base);
-        }))
-      continue;
     ++hypothesis.frames;
     alive.push_back(hypothesis);
     frame_log_likelihood.push_back(log_likelihood(thinned, hypothesis.T_map_base));
