@@ -148,3 +148,32 @@ TEST_CASE("sim-room-37-rig: a misaligned rig scans as well as the designed one w
     CHECK(wrong->near_segment_share() <= 0.5);
   }
 }
+
+// The frame's placement error (the spread of floor edges' outer twins about where the floor
+// puts them) grows when blur and noise are added: the degradation stage's defocus and sensor
+// noise move each edge by a fraction of a row.
+TEST_CASE("sim-room-37-real: the twin spread measures the placement error the degradation adds",
+          "[stereo][floor][dataset]") {
+  const omnislam::test::TruthDataset data =
+      omnislam::test::load_truth_dataset(dataset_dir("sim-room-37-real"));
+  omnislam::stereo::ScanConfig config;
+  config.camera = data.info.camera;
+  config.camera_height_m = data.info.camera_height_m;
+  omnislam::stereo::ScanReconstructor reconstructor(config);
+  const omnislam::degrade::Degrader degrader({}, data.images.front().size());
+  double clean = 0.0, degraded = 0.0;
+  constexpr int kFrames = 6;
+  for (int i = 0; i < kFrames; ++i) {
+    const cv::Mat &image = data.images[static_cast<std::size_t>(i) * 6];
+    clean += reconstructor.reconstruct(image).stats.twin_spread_px;
+    const omnislam::degrade::Degraded result = degrader.apply(image, i * 6 + 1);
+    REQUIRE(result.error.empty());
+    degraded += reconstructor.reconstruct(result.image).stats.twin_spread_px;
+  }
+  clean /= kFrames;
+  degraded /= kFrames;
+  std::printf("sim-room-37-real twin spread: clean %.3f px, degraded %.3f px\n", clean, degraded);
+  CHECK(clean > 0.0);
+  CHECK(clean < 1.0);
+  CHECK(degraded > clean);
+}

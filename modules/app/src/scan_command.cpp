@@ -50,9 +50,9 @@ void print_summary(const std::string &image, const stereo::LocalScan &scan) {
   if (!scan.free_range_m.empty()) {
     std::fprintf(stderr,
                  "%s: floor boundary: floor texture %d, floor contacts %d (undecided %d), elevated %d, "
-                 "unexplained %d, residual scale %.4f\n",
+                 "unexplained %d, residual scale %.4f, twin spread %.3f px\n",
                  image.c_str(), s.floor_texture_edges, s.floor_contacts, s.undecided, s.elevated,
-                 s.unexplained, static_cast<double>(s.noise_scale));
+                 s.unexplained, static_cast<double>(s.noise_scale), static_cast<double>(s.twin_spread_px));
   }
 }
 

@@ -416,6 +416,7 @@ BoundaryStats FloorBoundaryFinder::find(const FloorGeometry &geometry, const cv:
   measure_twin_spread(inner_edges, outer_edges, inner_candidates, outer_candidates);
   BoundaryStats stats;
   stats.noise_scale = noise_scale_;
+  stats.twin_spread_px = twin_spread_px_;
   const double floor_height_m = -geometry_->camera_height_m();
   points.clear();
   free_range_m.assign(static_cast<std::size_t>(inner_candidates.columns()), kNaN);

@@ -180,6 +180,7 @@ void ScanReconstructor::build_boundary_scan(LocalScan &scan) {
   scan.stats.elevated = boundary_stats_.elevated;
   scan.stats.unexplained = boundary_stats_.unexplained;
   scan.stats.noise_scale = boundary_stats_.noise_scale;
+  scan.stats.twin_spread_px = boundary_stats_.twin_spread_px;
   for (const BoundaryPoint &point : boundary_points_) {
     add_point(point.column, point.range_m, point.height_m, point.inner_row, point.outer_row, scan);
   }

@@ -62,12 +62,13 @@ struct BoundaryPoint {
 };
 
 struct BoundaryStats {
-  int floor_texture = 0;     ///< edges the floor hypothesis explained
-  int floor_contacts = 0;    ///< boundaries on the floor (vertical surface or undecided)
-  int undecided = 0;         ///< of which the test ran out of rows
-  int elevated = 0;          ///< boundaries above the floor (triangulated)
-  int unexplained = 0;       ///< edges off the floor without an outer match
-  float noise_scale = 0.0f;  ///< residual scale used by the test (intensity in [0, 1])
+  int floor_texture = 0;        ///< edges the floor hypothesis explained
+  int floor_contacts = 0;       ///< boundaries on the floor (vertical surface or undecided)
+  int undecided = 0;            ///< of which the test ran out of rows
+  int elevated = 0;             ///< boundaries above the floor (triangulated)
+  int unexplained = 0;          ///< edges off the floor without an outer match
+  float noise_scale = 0.0f;     ///< residual scale used by the test (intensity in [0, 1])
+  float twin_spread_px = 0.0f;  ///< the lobes' sub-pixel placement error (Laplace scale, rows)
 };
 
 /// Scratch images between frames; not thread-safe (one per thread).

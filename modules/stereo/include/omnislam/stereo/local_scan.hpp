@@ -50,7 +50,10 @@ struct ScanStats {
   int elevated = 0;             ///< boundaries above the floor (triangulated)
   int unexplained = 0;          ///< edges off the floor without an outer match
   float noise_scale = 0.0f;     ///< photometric residual scale (intensity in [0, 1])
-  int points = 0;               ///< points in the scan
+  /// Sub-pixel placement error of the frame's edges (rows, Laplace scale): the spread of floor
+  /// edges' outer twins about where the floor puts them.
+  float twin_spread_px = 0.0f;
+  int points = 0;  ///< points in the scan
 };
 
 enum class ScanStatus {
