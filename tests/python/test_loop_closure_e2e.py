@@ -102,7 +102,7 @@ def test_building_two_laps_through_plain_corridors(tmp_path):
     assert evaluation["online_ate"]["final_m"] <= 1.5 * ate["final_m"] + 0.005
     assert evaluation["map"]["median_distance_m"] <= 0.05
     assert summary["loop_closures"] >= 10
-    # Published covariance (issue 13): measured mean NEES 5.2, 95.1% inside the 95% ellipse.
+    # Published covariance (issue 13): measured mean NEES 3.9, 100% inside the 95% ellipse.
     mean_nees, inside = covariance_consistency(tmp_path / "on", ROOT / "datasets" / "building-2laps")
     assert 1.0 <= mean_nees <= 10.0
     assert inside >= 0.80

@@ -126,15 +126,22 @@ TEST_CASE("SLAM without odometry (thesis sec. 5.2) tracks a lap in a well-constr
 
 TEST_CASE("SLAM: the published covariance carries the previous pose's and adds each registration's",
           "[slam][covariance]") {
-  // The map each frame registers against was built from the frames before it: the published
-  // covariance is the previous one carried to this pose (its heading variance swinging into
-  // the position by the lever arm between the two poses) plus this registration's robust one,
-  // so over a run it grows; a frame without a registration adds its odometry step's instead.
+  // The map each frame registers against was built from the frames before it: the covariance
+  // is a random walk, the previous one carried to this pose (its heading variance swinging
+  // into the position by the lever arm between the two poses) plus this registration's
+  // robust one, so over a run it grows; a frame without a registration adds its odometry
+  // step's instead. Each registration's is estimated with few degrees of freedom (its sectors
+  // less one), summed over the walk as Welch and Satterthwaite do (terms sized by their
+  // position variance), and the walk is published as the t's covariance, dof / (dof - 2)
+  // times it: 1.4x after the first registration, nearer 1 as the walk sums more of them.
   Slam slam;
   const auto walls = omnislam::test::l_room();
   std::mt19937_64 rng(9);
-  Eigen::Matrix3d previous = Eigen::Matrix3d::Zero();
+  Eigen::Matrix3d walk = Eigen::Matrix3d::Zero();
+  double shares = 0.0;  // sum of size^2 / dof over the walk's terms
   Eigen::Isometry2d previous_pose = Eigen::Isometry2d::Identity();
+  Eigen::Matrix3d previous = Eigen::Matrix3d::Zero();
+  double factor = 0.0;
   for (int i = 0; i < 8; ++i) {
     const Eigen::Isometry2d truth = pose(0.1 * i, 0.02 * i, 0.01 * i);
     const auto estimate = slam.process(omnislam::test::scan_from(walls, truth, rng), truth);
@@ -144,14 +151,29 @@ TEST_CASE("SLAM: the published covariance carries the previous pose's and adds e
       Eigen::Matrix3d F = Eigen::Matrix3d::Identity();
       F(0, 2) = -lever.y();
       F(1, 2) = lever.x();
-      const Eigen::Matrix3d expected = F * previous * F.transpose() + estimate.registration.robust_covariance;
-      INFO("frame " << i << " covariance\n" << estimate.covariance << "\nexpected\n" << expected);
+      const Eigen::Matrix3d carried = F * walk * F.transpose();
+      const double carried_size = carried.topLeftCorner<2, 2>().trace();
+      const double walk_size = walk.topLeftCorner<2, 2>().trace();
+      // Carrying rescales the walk's earlier terms alike: its degrees of freedom stay.
+      if (walk_size > 0.0) shares *= (carried_size * carried_size) / (walk_size * walk_size);
+      const Eigen::Matrix3d &term = estimate.registration.robust_covariance;
+      REQUIRE(estimate.registration.covariance_dof == 7.0);
+      shares += std::pow(term.topLeftCorner<2, 2>().trace(), 2) / 7.0;
+      walk = carried + term;
+      const double dof = std::pow(walk.topLeftCorner<2, 2>().trace(), 2) / shares;
+      factor = dof / (dof - 2.0);
+      const Eigen::Matrix3d expected = factor * walk;
+      INFO("frame " << i << " dof " << dof << " covariance\n"
+                    << estimate.covariance << "\nexpected\n"
+                    << expected);
       CHECK(estimate.covariance.isApprox(expected, 1e-9));
+      if (i == 1) CHECK(factor == Approx(1.4));
       CHECK(estimate.covariance.trace() > previous.trace());
     }
     previous = estimate.covariance;
     previous_pose = estimate.T_map_base;
   }
+  CHECK(factor < 1.1);  // seven registrations of about one size: ~45 degrees of freedom
   // Too few points: no registration, the odometry step's uncertainty is added.
   const auto blind = slam.process({{1.0, 0.0}}, pose(0.9, 0.16, 0.08));
   CHECK_FALSE(blind.integrated);

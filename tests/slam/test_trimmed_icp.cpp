@@ -1,6 +1,7 @@
 #include <Eigen/Eigenvalues>
 #include <catch2/catch.hpp>
 #include <cmath>
+#include <limits>
 #include <random>
 
 #include "omnislam/slam/trimmed_icp.hpp"
@@ -157,4 +158,36 @@ TEST_CASE("trimmed ICP: the cluster-robust covariance covers an error shared by 
   const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> difference(result.robust_covariance -
                                                                   result.covariance);
   CHECK(difference.eigenvalues().minCoeff() > -1e-15);
+}
+
+TEST_CASE("trimmed ICP: the robust covariance's degrees of freedom are its sectors less one",
+          "[slam][icp][covariance]") {
+  // A room seen all round fills every bearing sector: eight sectors give seven degrees of
+  // freedom (their scores sum to zero at the fit). With one sector the independent estimate
+  // stands in, with as many as the pairs less the three parameters.
+  const auto walls = omnislam::test::l_room();
+  std::mt19937_64 rng(6);
+  const Eigen::Isometry2d T_map_scan = pose(1.0, 1.0, 0.0);
+  const NearestNeighbors model(omnislam::test::scan_from(walls, T_map_scan, rng, 0.002));
+  const Points2 sample = omnislam::test::scan_from(walls, T_map_scan, rng, 0.002);
+  const auto sectors = register_trimmed_icp(model, sample, pose(0.02, -0.01, 0.01));
+  REQUIRE(sectors.valid);
+  CHECK(sectors.covariance_dof == 7.0);
+  omnislam::slam::TrimmedIcpConfig independent;
+  independent.covariance_sectors = 1;
+  const auto pairs = register_trimmed_icp(model, sample, pose(0.02, -0.01, 0.01), independent);
+  REQUIRE(pairs.valid);
+  CHECK(pairs.covariance_dof == static_cast<double>(pairs.kept_pairs) - 3.0);
+}
+
+TEST_CASE("trimmed ICP: the predictive covariance is the t's, dof / (dof - 2) times the estimate",
+          "[slam][icp][covariance]") {
+  using omnislam::slam::predictive_covariance;
+  const Eigen::Matrix3d estimate = Eigen::Vector3d(4e-6, 1e-6, 1e-5).asDiagonal();
+  CHECK(predictive_covariance(estimate, 7.0).isApprox(estimate * 1.4));
+  CHECK(predictive_covariance(estimate, 70.0).isApprox(estimate * 70.0 / 68.0));
+  // A model's covariance (infinitely many degrees of freedom) is published as it is.
+  CHECK(predictive_covariance(estimate, std::numeric_limits<double>::infinity()) == estimate);
+  // Fewer than three would have no finite variance: three are assumed.
+  CHECK(predictive_covariance(estimate, 1.0).isApprox(estimate * 3.0));
 }

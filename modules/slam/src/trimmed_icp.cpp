@@ -190,13 +190,20 @@ Eigen::Vector3d leverage_adjusted_score(const Eigen::Matrix3d &A_g, const Eigen:
   return adjusted;
 }
 
+struct RobustCovariance {
+  Eigen::Matrix3d covariance;
+  double dof;  ///< its degrees of freedom as an estimate (TrimmedIcpResult::covariance_dof)
+};
+
 // Cluster-robust covariance (the sandwich A^-1 B A^-1 with A = J^T J and B the sum over
 // clusters of the outer product of each cluster's leverage-adjusted score): residuals are
 // free to be correlated inside a cluster, and only the clusters are taken as independent.
 // Clusters are bearing sectors of the sample frame.
-Eigen::Matrix3d robust_covariance_of(const std::vector<Pair> &pairs, const Motion &motion, int sectors,
-                                     const Eigen::Matrix3d &independent) {
-  if (sectors < 2) return independent;
+RobustCovariance robust_covariance_of(const std::vector<Pair> &pairs, const Motion &motion, int sectors,
+                                      const Eigen::Matrix3d &independent) {
+  // The independent estimate has as many degrees of freedom as pairs beyond the parameters.
+  const RobustCovariance fallback{independent, std::max(1.0, static_cast<double>(pairs.size()) - 3.0)};
+  if (sectors < 2) return fallback;
   std::vector<Eigen::Vector3d> scores(static_cast<std::size_t>(sectors), Eigen::Vector3d::Zero());
   std::vector<Eigen::Matrix3d> grams(static_cast<std::size_t>(sectors), Eigen::Matrix3d::Zero());
   std::vector<bool> used(static_cast<std::size_t>(sectors), false);
@@ -211,7 +218,7 @@ Eigen::Matrix3d robust_covariance_of(const std::vector<Pair> &pairs, const Motio
     used[static_cast<std::size_t>(sector)] = true;
   }
   const auto clusters = static_cast<double>(std::count(used.begin(), used.end(), true));
-  if (clusters < 2.0 || std::abs(A.determinant()) < 1e-12) return independent;
+  if (clusters < 2.0 || std::abs(A.determinant()) < 1e-12) return fallback;
   const Eigen::Matrix3d A_inverse = A.inverse();
   Eigen::Matrix3d B = Eigen::Matrix3d::Zero();
   for (std::size_t g = 0; g < scores.size(); ++g) {
@@ -223,13 +230,15 @@ Eigen::Matrix3d robust_covariance_of(const std::vector<Pair> &pairs, const Motio
   // Never more confident than the independent estimate in any direction: in coordinates
   // where that one is the identity, the sandwich's variances below 1 are raised to 1.
   const Eigen::LLT<Eigen::Matrix3d> independent_factor(independent);
-  if (independent_factor.info() != Eigen::Success) return independent;
+  if (independent_factor.info() != Eigen::Success) return fallback;
   const Eigen::Matrix3d L = independent_factor.matrixL();
   const Eigen::Matrix3d L_inverse = L.inverse();
   const Eigen::Matrix3d whitened = L_inverse * sandwich * L_inverse.transpose();
   const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> axes(0.5 * (whitened + whitened.transpose()));
   const Eigen::Vector3d raised = axes.eigenvalues().cwiseMax(1.0);
-  return L * axes.eigenvectors() * raised.asDiagonal() * axes.eigenvectors().transpose() * L.transpose();
+  // The scores of the clusters sum to zero at the fit: one fewer independent one than clusters.
+  return {L * axes.eigenvectors() * raised.asDiagonal() * axes.eigenvectors().transpose() * L.transpose(),
+          clusters - 1.0};
 }
 
 }  // namespace
@@ -298,9 +307,17 @@ TrimmedIcpResult register_trimmed_icp(const NearestNeighbors &model, const Point
   for (const Point2 &p : sample) inliers += model.nearest(returned.apply(p), kInlierDistanceM) ? 1 : 0;
   result.inlier_share = static_cast<double>(inliers) / static_cast<double>(sample.size());
   result.covariance = covariance_of(pairs, returned, result.final_error_m2);
-  result.robust_covariance =
+  const RobustCovariance robust =
       robust_covariance_of(pairs, returned, config.covariance_sectors, result.covariance);
+  result.robust_covariance = robust.covariance;
+  result.covariance_dof = robust.dof;
   return result;
+}
+
+Eigen::Matrix3d predictive_covariance(const Eigen::Matrix3d &estimate, double dof) {
+  if (!std::isfinite(dof)) return estimate;
+  const double nu = std::max(dof, kMinPredictiveDof);
+  return estimate * (nu / (nu - 2.0));
 }
 
 }  // namespace omnislam::slam

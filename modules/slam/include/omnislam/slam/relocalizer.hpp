@@ -63,11 +63,12 @@ enum class LocalizationState { kSearching, kLocalized };
 struct LocalizationResult {
   LocalizationState state = LocalizationState::kSearching;
   Eigen::Isometry2d T_map_base = Eigen::Isometry2d::Identity();  ///< when localized
-  Eigen::Matrix3d covariance =
-      Eigen::Matrix3d::Zero();  ///< of the last refinement (x, y, yaw), cluster-robust
-  int hypotheses = 0;           ///< alive after this frame
-  double best_score = 0.0;      ///< of the frame's best hypothesis
-  int searched_poses = 0;       ///< candidates the correlative search returned
+  /// Of the last refinement (x, y, yaw): its cluster-robust estimate as the t's covariance for
+  /// the estimate's degrees of freedom (slam/trimmed_icp.hpp predictive_covariance).
+  Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
+  int hypotheses = 0;       ///< alive after this frame
+  double best_score = 0.0;  ///< of the frame's best hypothesis
+  int searched_poses = 0;   ///< candidates the correlative search returned
 };
 
 class Relocalizer {

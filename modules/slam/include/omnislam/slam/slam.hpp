@@ -3,6 +3,7 @@
 #include <Eigen/Geometry>
 #include <cstdint>
 #include <deque>
+#include <limits>
 #include <memory>
 #include <optional>
 
@@ -178,9 +179,10 @@ class Slam {
  private:
   [[nodiscard]] bool accept(const TrimmedIcpResult &registration, const Eigen::Isometry2d &predicted,
                             const Eigen::Isometry2d &estimate, double srel_limit_percent) const;
-  /// The covariance published with `estimate`, `step` the odometry motion it was predicted by.
+  /// The covariance published with `estimate`, `step` the odometry motion it was predicted by;
+  /// advances the random walk it is made of (walk_covariance_) to this frame.
   [[nodiscard]] Eigen::Matrix3d published_covariance(const FrameEstimate &estimate,
-                                                     const Eigen::Isometry2d &step) const;
+                                                     const Eigen::Isometry2d &step);
   [[nodiscard]] FrameEstimate register_scan(const Points2 &scan_base, const Eigen::Isometry2d &predicted);
   /// How far beyond a scan at its predicted pose the map must be indexed for a registration
   /// to see all it would see in the whole map: the first search radius, the largest
@@ -232,6 +234,11 @@ class Slam {
   /// the last integrated frame (or an operator's pose), in the odometry_gate.
   Eigen::Matrix3d prediction_covariance_ = Eigen::Matrix3d::Zero();
   Eigen::Matrix3d uncommitted_covariance_ = Eigen::Matrix3d::Zero();
+  /// The random walk behind the published covariance: the sum of its terms as estimated, and
+  /// the sum's degrees of freedom (Welch-Satterthwaite; infinite while every term comes from
+  /// a model: odometry, an operator's or a saved pose).
+  Eigen::Matrix3d walk_covariance_ = Eigen::Matrix3d::Zero();
+  double walk_dof_ = std::numeric_limits<double>::infinity();
   bool predicted_by_odometry_ = false;  ///< the current frame's prediction came from odometry
   bool previous_failed_ = false;
 };

@@ -54,7 +54,21 @@ struct TrimmedIcpResult {
   /// sigma^2 (J^T J)^-1 above, which treats every pair as an independent measurement, is
   /// smaller than the error the fit actually makes. Never smaller than `covariance`.
   Eigen::Matrix3d robust_covariance = Eigen::Matrix3d::Zero();
+  /// Degrees of freedom of robust_covariance as an estimate of the error's covariance: the
+  /// sectors that held pairs less one (their scores sum to zero at the fit), or the pairs
+  /// less three where the independent estimate stands in. Eight sectors give seven: the
+  /// estimate itself is uncertain (predictive_covariance).
+  double covariance_dof = 0.0;
 };
+
+/// Fewest degrees of freedom predictive_covariance assumes (a t with fewer has no variance).
+inline constexpr double kMinPredictiveDof = 3.0;
+
+/// The covariance of the error when `estimate` is itself estimated with `dof` degrees of
+/// freedom: the error then follows a multivariate t with that scale matrix, whose covariance
+/// is dof / (dof - 2) times it (3x with 3 dof, 1.4x with 7, 1.03x with 70; unchanged for
+/// infinite dof, a covariance known from a model). dof is taken as at least kMinPredictiveDof.
+[[nodiscard]] Eigen::Matrix3d predictive_covariance(const Eigen::Matrix3d &estimate, double dof);
 
 /// A Gaussian prior on the registered position (an odometry prediction): where the pairs do
 /// not constrain it (along a plain corridor) it holds the position; elsewhere the pairs,
