@@ -84,9 +84,8 @@ std::vector<Relocalizer::Hypothesis> Relocalizer::rivals(const Points2 &scan_bas
     if (!admissible(score, candidates_best)) continue;
     const double behind = own - log_likelihood(thinned, refined->T_model_sample);
     if (behind > margin) continue;
-    found.push_back({refined->T_model_sample,
-                     predictive_covariance(refined->robust_covariance, refined->covariance_dof), score,
-                     std::max(behind, 0.0), 1});
+    found.push_back(
+        {refined->T_model_sample, predictive_covariance(*refined), score, std::max(behind, 0.0), 1});
   }
   return found;
 }
@@ -107,7 +106,7 @@ LocalizationResult Relocalizer::process(const Points2 &scan_base,
     if (static_cast<int>(scan_base.size()) >= config_.min_scan_points) {
       if (const auto refined = refine(scan_base, localized_->T_map_base)) {
         localized_->T_map_base = refined->T_model_sample;
-        localized_->covariance = predictive_covariance(refined->robust_covariance, refined->covariance_dof);
+        localized_->covariance = predictive_covariance(*refined);
       }
     }
     result.state = LocalizationState::kLocalized;
@@ -148,7 +147,7 @@ LocalizationResult Relocalizer::process(const Points2 &scan_base,
         }))
       continue;
     hypothesis.T_map_base = refined->T_model_sample;
-    hypothesis.covariance = predictive_covariance(refined->robust_covariance, refined->covariance_dof);
+    hypothesis.covariance = predictive_covariance(*refined);
     hypothesis.score = matcher_.score(scan_base, hypothesis.T_map_base);
     if (hypothesis.score < config_.min_score) continue;
     ++hypothesis.frames;
@@ -186,15 +185,14 @@ LocalizationResult Relocalizer::process(const Points2 &scan_base,
       if (likelihood > frame_log_likelihood[i] ||
           (likelihood == frame_log_likelihood[i] && score > known->score)) {
         known->T_map_base = pose;
-        known->covariance = predictive_covariance(refined->robust_covariance, refined->covariance_dof);
+        known->covariance = predictive_covariance(*refined);
         known->score = score;
         frame_log_likelihood[i] = likelihood;
       }
       continue;
     }
     if (!admissible(score, candidates_best)) continue;
-    alive.push_back(
-        {pose, predictive_covariance(refined->robust_covariance, refined->covariance_dof), score, 0.0, 1});
+    alive.push_back({pose, predictive_covariance(*refined), score, 0.0, 1});
     frame_log_likelihood.push_back(likelihood);
   }
   // Each hypothesis falls behind the frame's best by what this frame says (a new one: by

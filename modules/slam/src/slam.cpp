@@ -32,9 +32,12 @@ Eigen::Matrix3d carried(const Eigen::Matrix3d &covariance, const Eigen::Isometry
   return F * covariance * F.transpose();
 }
 
-// One term's share of the Welch-Satterthwaite denominator, sized by its position variance.
+// A covariance's size for Welch-Satterthwaite: its position variance.
+double position_size(const Eigen::Matrix3d &covariance) { return covariance.topLeftCorner<2, 2>().trace(); }
+
+// One term's share of the Welch-Satterthwaite denominator.
 double satterthwaite_share(const Eigen::Matrix3d &term, double dof) {
-  const double size = term.topLeftCorner<2, 2>().trace();
+  const double size = position_size(term);
   return std::isfinite(dof) ? size * size / dof : 0.0;
 }
 
@@ -70,7 +73,7 @@ Eigen::Matrix3d Slam::published_covariance(const FrameEstimate &estimate, const 
       estimate.integrated ? registration.covariance_dof : std::numeric_limits<double>::infinity();
   const double shares = satterthwaite_share(before, walk_dof_) + satterthwaite_share(term, term_dof);
   walk_covariance_ = before + term;
-  const double size = walk_covariance_.topLeftCorner<2, 2>().trace();
+  const double size = position_size(walk_covariance_);
   walk_dof_ = shares > 0.0 ? size * size / shares : std::numeric_limits<double>::infinity();
   return predictive_covariance(walk_covariance_, walk_dof_);
 }

@@ -70,6 +70,11 @@ inline constexpr double kMinPredictiveDof = 3.0;
 /// infinite dof, a covariance known from a model). dof is taken as at least kMinPredictiveDof.
 [[nodiscard]] Eigen::Matrix3d predictive_covariance(const Eigen::Matrix3d &estimate, double dof);
 
+/// A registration's robust_covariance as the t's, for its covariance_dof.
+[[nodiscard]] inline Eigen::Matrix3d predictive_covariance(const TrimmedIcpResult &registration) {
+  return predictive_covariance(registration.robust_covariance, registration.covariance_dof);
+}
+
 /// A Gaussian prior on the registered position (an odometry prediction): where the pairs do
 /// not constrain it (along a plain corridor) it holds the position; elsewhere the pairs,
 /// weighted by their residual variance, outweigh it. Position only: the heading is what
