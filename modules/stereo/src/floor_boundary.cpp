@@ -215,7 +215,8 @@ float FloorBoundaryFinder::row_vote(float residual_against, float residual_for) 
 }
 
 FloorBoundaryFinder::Verdict FloorBoundaryFinder::floor_or_vertical(int column, float edge_row,
-                                                                    float contact_row) const {
+                                                                    float contact_row,
+                                                                    double *rows_llr) const {
   // Wald's sequential test, rows outwards from the edge. Rows inside the edge's own blur,
   // in either lobe, measure the sub-pixel placement of a steep edge rather than the
   // hypotheses, and do not vote. (The walk is the front-end's hottest loop, some 60 rows a
@@ -223,6 +224,7 @@ FloorBoundaryFinder::Verdict FloorBoundaryFinder::floor_or_vertical(int column, 
   // free so that the compiler vectorises them, and then summed in order until a decision;
   // a row that does not vote adds 0.)
   const int base = static_cast<int>(edge_row);
+  if (rows_llr != nullptr) *rows_llr = 0.0;
   if (base + 1 >= rows_) return Verdict::kUndecided;  // no surface tabulated that far
   const float fraction = edge_row - static_cast<float>(base);
   const float *near_base = geometry_->vertical_outer_rows(base);
@@ -260,24 +262,58 @@ FloorBoundaryFinder::Verdict FloorBoundaryFinder::floor_or_vertical(int column, 
       if (llr <= -decision_llr_) return Verdict::kVertical;
     }
   }
+  if (rows_llr != nullptr) *rows_llr = llr;
   return Verdict::kUndecided;
 }
 
-const vision::EdgePoint *FloorBoundaryFinder::floor_contact(
-    const vision::EdgePoint &edge, int column, const vision::EdgeImage &inner_edges,
-    const vision::EdgeImage &outer_edges, std::span<const vision::EdgePoint> outer_column) const {
-  const float floor_row = geometry_->floor_outer_row_at(edge.row_subpx);
-  const int sign = polarity(inner_edges, edge.row, column);
+const vision::EdgePoint *FloorBoundaryFinder::floor_contact(std::size_t index) const {
+  const float floor_row = geometry_->floor_outer_row_at(column_inner_[index].row_subpx);
+  const int sign = inner_sign_[index];
   const auto margin = static_cast<float>(config_.contact_margin_px);
   const vision::EdgePoint *contact = nullptr;
-  for (const vision::EdgePoint &outer : outer_column) {
+  for (std::size_t k = 0; k < column_outer_.size(); ++k) {
+    const vision::EdgePoint &outer = column_outer_[k];
     const float offset = std::abs(outer.row_subpx - floor_row);
-    if (offset <= margin && polarity(outer_edges, outer.row, column) == sign &&
+    if (offset <= margin && outer_sign_[k] == sign &&
         (contact == nullptr || offset < std::abs(contact->row_subpx - floor_row))) {
       contact = &outer;
     }
   }
   return contact;
+}
+
+float FloorBoundaryFinder::twin_offset(float outer_row, int sign) const {
+  float nearest = kTwinSearchRows;
+  for (std::size_t k = 0; k < column_outer_.size(); ++k) {
+    if (outer_sign_[k] == sign) nearest = std::min(nearest, std::abs(column_outer_[k].row_subpx - outer_row));
+  }
+  return nearest;
+}
+
+bool FloorBoundaryFinder::floor_seen_beyond(std::size_t index, float contact_row, double rows_llr) const {
+  // Each edge beyond with an outer twin on the floor is a feature of the floor if the floor
+  // goes on, or of the surface standing at this edge if it does not; its twin's offset from
+  // where each puts it is Laplace with the frame's placement error (measure_twin_spread),
+  // so its log-likelihood ratio is the difference of the two offsets over that spread (the
+  // nearest twin of the edge's polarity to the surface's row; none within kTwinSearchRows
+  // counts as that far). Independent of the rows' smoothed residuals, it adds to their sum.
+  if (!(twin_spread_px_ > 0.0f)) return false;
+  const float base_row = column_inner_[index].row_subpx;
+  double llr = rows_llr;
+  for (std::size_t next = index + 1; next < column_inner_.size(); ++next) {
+    const vision::EdgePoint *contact = contacts_[next];
+    if (contact == nullptr) continue;
+    const vision::EdgePoint &edge = column_inner_[next];
+    const float surface_row = geometry_->vertical_outer_row_subpx(edge.row_subpx, base_row);
+    // Near the base the two surfaces meet and the base's own twin stands for both.
+    if (!std::isfinite(surface_row) ||
+        std::abs(surface_row - contact_row) <= static_cast<float>(kEdgeBlurRows))
+      continue;
+    const float floor_offset = std::abs(contact->row_subpx - geometry_->floor_outer_row_at(edge.row_subpx));
+    llr += (twin_offset(surface_row, inner_sign_[next]) - floor_offset) / twin_spread_px_;
+    if (llr >= decision_llr_) return true;
+  }
+  return false;
 }
 
 bool FloorBoundaryFinder::vertical_beyond(int column, std::span<const vision::EdgePoint> edges,
@@ -428,9 +464,17 @@ BoundaryStats FloorBoundaryFinder::find(const FloorGeometry &geometry, const cv:
     const auto inner_edges_here = inner_candidates.column(column);
     // 1. Is there an outer edge of the same polarity where the floor puts each edge? (Asked
     //    once per edge: steps 4 and 5 ask it again of the edges above.)
-    contacts_.clear();
+    column_inner_ = inner_edges_here;
+    column_outer_ = outer_edges_here;
+    inner_sign_.clear();
+    outer_sign_.clear();
     for (const vision::EdgePoint &edge : inner_edges_here)
-      contacts_.push_back(floor_contact(edge, column, inner_edges, outer_edges, outer_edges_here));
+      inner_sign_.push_back(polarity(inner_edges, edge.row, column));
+    for (const vision::EdgePoint &edge : outer_edges_here)
+      outer_sign_.push_back(polarity(outer_edges, edge.row, column));
+    contacts_.clear();
+    for (std::size_t index = 0; index < inner_edges_here.size(); ++index)
+      contacts_.push_back(floor_contact(index));
     for (std::size_t index = 0; index < inner_edges_here.size(); ++index) {
       const vision::EdgePoint &edge = inner_edges_here[index];
       const float floor_row = geometry_->floor_outer_row_at(edge.row_subpx);
@@ -467,11 +511,15 @@ BoundaryStats FloorBoundaryFinder::find(const FloorGeometry &geometry, const cv:
       }
       // 3. On the floor: floor going on, or a vertical surface standing here?
       float outer_row = contact != nullptr ? contact->row_subpx : floor_row;
-      const Verdict verdict = floor_or_vertical(column, edge.row_subpx, outer_row);
-      // An undecided edge (the rows beyond too uniform to tell) with a surface decisively
-      // standing on the floor farther out was floor texture: the floor reaches that surface.
-      const bool floor_reaches_farther = verdict == Verdict::kUndecided && contact != nullptr &&
-                                         vertical_beyond(column, inner_edges_here, index);
+      double rows_llr = 0.0;
+      const Verdict verdict = floor_or_vertical(column, edge.row_subpx, outer_row, &rows_llr);
+      // An undecided edge (the rows beyond too uniform to tell) was floor texture when the
+      // floor is seen beyond it: the twins of the edges on the floor farther out, with the
+      // rows' evidence, decisively place them on the floor rather than on a surface standing
+      // here; or a surface decisively stands on the floor farther out.
+      const bool floor_reaches_farther =
+          verdict == Verdict::kUndecided && contact != nullptr &&
+          (floor_seen_beyond(index, outer_row, rows_llr) || vertical_beyond(column, inner_edges_here, index));
       if (verdict == Verdict::kFloor || floor_reaches_farther) {
         ++stats.floor_texture;
         farthest_floor_row = edge.row_subpx;

@@ -37,12 +37,16 @@
 ///     at the configured error rate. Floor wins: the edge is floor texture, and evidence of
 ///     free floor; the search goes on. The vertical surface wins, or the column ends
 ///     undecided (a uniform wall explains both equally): the edge is where the floor ends,
-///     unless (undecided) an edge farther out stands on the floor and is decisively a
-///     vertical surface: the floor reaches it. A row neither hypothesis explains (a dust
-///     speck, a highlight, a third surface in between) does not vote.
-///     Its range is the floor range of the edge row (the floor plane is far more precise
-///     than the stereo disparity: ~16 mm per row at 1-2 m against ~130 mm per pixel of
-///     disparity, mirror.md sec. 9).
+///     unless (undecided) the floor is seen beyond it: the edges farther out whose outer
+///     twins sit on the floor place them there decisively rather than on a surface standing
+///     at the edge (each twin's offset from either row, over the frame's placement error, adds
+///     to the rows' evidence; at 3-5 m, where few rows lie between floor texture and a wall,
+///     the twins tell what the smoothed rows cannot), or an edge farther out stands on the
+///     floor and is decisively a vertical surface: the floor reaches it. A row neither
+///     hypothesis explains (a dust speck, a highlight, a third surface in between) does not
+///     vote. Its range is the floor range of the edge row (the floor plane is far more
+///     precise than the stereo disparity: ~16 mm per row at 1-2 m against ~130 mm per pixel
+///     of disparity, mirror.md sec. 9).
 ///  4. Unless the next edge on the floor, as the base, explains the rows beyond better
 ///     (floor texture just in front of a wall).
 ///  5. And unless an edge higher up matches decisively above the floor and lies nearer in
@@ -92,20 +96,28 @@ class FloorBoundaryFinder {
   void fit_lobe_gain();
   void measure_noise_scale();
   /// Wald's test over the rows above `edge_row`: floor going on, a vertical surface standing
-  /// at the edge's floor range, or neither decisively (the column ran out of rows).
+  /// at the edge's floor range, or neither decisively (the column ran out of rows; then
+  /// `rows_llr`, if given, gets the log-likelihood ratio the rows reached, positive for floor).
   enum class Verdict { kFloor, kVertical, kUndecided };
-  [[nodiscard]] Verdict floor_or_vertical(int column, float edge_row, float contact_row) const;
+  [[nodiscard]] Verdict floor_or_vertical(int column, float edge_row, float contact_row,
+                                          double *rows_llr = nullptr) const;
+  /// Whether the floor is decisively seen beyond the current column's edge `index`: the rows'
+  /// log-likelihood ratio `rows_llr` plus that of each farther edge with an outer twin on the
+  /// floor (the twin's offset from a surface standing at the edge against its offset from
+  /// the floor, in units of the frame's placement error).
+  [[nodiscard]] bool floor_seen_beyond(std::size_t index, float contact_row, double rows_llr) const;
+  /// Offset of the current column's outer edge of polarity `sign` nearest `outer_row`, at
+  /// most kTwinSearchRows.
+  [[nodiscard]] float twin_offset(float outer_row, int sign) const;
   [[nodiscard]] float outer_at(float row, int column) const;
   /// One column-major line (a column of a lobe) at a fractional row, clamped to the lobe.
   [[nodiscard]] float interpolate(const float *line, float row) const;
   /// Vote of one row for the hypothesis with `residual_for` (positive) over the other,
   /// in residual scales, less the dead zone, capped.
   [[nodiscard]] float row_vote(float residual_against, float residual_for) const;
-  /// The outer edge of the same polarity where the floor puts `edge`, or nullptr.
-  [[nodiscard]] const vision::EdgePoint *floor_contact(const vision::EdgePoint &edge, int column,
-                                                       const vision::EdgeImage &inner_edges,
-                                                       const vision::EdgeImage &outer_edges,
-                                                       std::span<const vision::EdgePoint> outer_column) const;
+  /// The outer edge of the same polarity where the floor puts the current column's edge
+  /// `index`, or nullptr.
+  [[nodiscard]] const vision::EdgePoint *floor_contact(std::size_t index) const;
   /// The outer edge nearer than the floor that explains `edge`'s window decisively better
   /// than the floor's prediction (an edge above the floor), or nullptr. If
   /// `standing_outer_row` is finite (the row a surface standing at the boundary puts the
@@ -162,6 +174,9 @@ class FloorBoundaryFinder {
   float gain_slope_ = 0.0f;
   std::vector<float> ratios_;
   std::vector<const vision::EdgePoint *> contacts_;  ///< per edge of the current column
+  std::span<const vision::EdgePoint> column_inner_;  ///< the current column's edges, nearest first
+  std::span<const vision::EdgePoint> column_outer_;
+  std::vector<int> inner_sign_, outer_sign_;  ///< their polarities (+1: brighter upwards)
   float noise_scale_ = 0.0f;
   float twin_spread_px_ = 0.0f;
   float ambiguous_offset_px_ = 0.0f;

@@ -1,5 +1,6 @@
 #pragma once
 
+#include <cmath>
 #include <limits>
 #include <vector>
 
@@ -53,6 +54,12 @@ class FloorGeometry {
     const float fraction = base_row - static_cast<float>(below);
     const float a = vertical_outer_row(row, below), b = vertical_outer_row(row, below + 1);
     return a + fraction * (b - a);
+  }
+  /// The same for a fractional row as well (linear between the two rows around it).
+  [[nodiscard]] float vertical_outer_row_subpx(float row, float base_row) const {
+    const int below = static_cast<int>(row);
+    const float a = vertical_outer_row_at(below, base_row), b = vertical_outer_row_at(below + 1, base_row);
+    return std::isfinite(b) ? a + (row - static_cast<float>(below)) * (b - a) : a;
   }
 
  private:
