@@ -266,28 +266,19 @@ FloorBoundaryFinder::Verdict FloorBoundaryFinder::floor_or_vertical(int column, 
   return Verdict::kUndecided;
 }
 
-const vision::EdgePoint *FloorBoundaryFinder::floor_contact(std::size_t index) const {
-  const float floor_row = geometry_->floor_outer_row_at(column_inner_[index].row_subpx);
-  const int sign = inner_sign_[index];
-  const auto margin = static_cast<float>(config_.contact_margin_px);
-  const vision::EdgePoint *contact = nullptr;
+FloorBoundaryFinder::Twin FloorBoundaryFinder::nearest_twin(float outer_row, int sign) const {
+  Twin twin;
   for (std::size_t k = 0; k < column_outer_.size(); ++k) {
-    const vision::EdgePoint &outer = column_outer_[k];
-    const float offset = std::abs(outer.row_subpx - floor_row);
-    if (offset <= margin && outer_sign_[k] == sign &&
-        (contact == nullptr || offset < std::abs(contact->row_subpx - floor_row))) {
-      contact = &outer;
-    }
+    const float offset = std::abs(column_outer_[k].row_subpx - outer_row);
+    if (outer_sign_[k] == sign && offset < twin.offset) twin = {&column_outer_[k], offset};
   }
-  return contact;
+  return twin;
 }
 
-float FloorBoundaryFinder::twin_offset(float outer_row, int sign) const {
-  float nearest = kTwinSearchRows;
-  for (std::size_t k = 0; k < column_outer_.size(); ++k) {
-    if (outer_sign_[k] == sign) nearest = std::min(nearest, std::abs(column_outer_[k].row_subpx - outer_row));
-  }
-  return nearest;
+const vision::EdgePoint *FloorBoundaryFinder::floor_contact(std::size_t index) const {
+  const Twin twin =
+      nearest_twin(geometry_->floor_outer_row_at(column_inner_[index].row_subpx), inner_sign_[index]);
+  return twin.offset <= static_cast<float>(config_.contact_margin_px) ? twin.edge : nullptr;
 }
 
 bool FloorBoundaryFinder::floor_seen_beyond(std::size_t index, float contact_row, double rows_llr) const {
@@ -310,17 +301,19 @@ bool FloorBoundaryFinder::floor_seen_beyond(std::size_t index, float contact_row
         std::abs(surface_row - contact_row) <= static_cast<float>(kEdgeBlurRows))
       continue;
     const float floor_offset = std::abs(contact->row_subpx - geometry_->floor_outer_row_at(edge.row_subpx));
-    llr += (twin_offset(surface_row, inner_sign_[next]) - floor_offset) / twin_spread_px_;
+    const float surface_offset =
+        std::min(nearest_twin(surface_row, inner_sign_[next]).offset, kTwinSearchRows);
+    llr += (surface_offset - floor_offset) / twin_spread_px_;
     if (llr >= decision_llr_) return true;
   }
   return false;
 }
 
-bool FloorBoundaryFinder::vertical_beyond(int column, std::span<const vision::EdgePoint> edges,
-                                          std::size_t index) const {
-  for (std::size_t next = index + 1; next < edges.size(); ++next) {
+bool FloorBoundaryFinder::vertical_beyond(int column, std::size_t index) const {
+  for (std::size_t next = index + 1; next < column_inner_.size(); ++next) {
     if (contacts_[next] == nullptr) continue;
-    if (floor_or_vertical(column, edges[next].row_subpx, contacts_[next]->row_subpx) == Verdict::kVertical)
+    if (floor_or_vertical(column, column_inner_[next].row_subpx, contacts_[next]->row_subpx) ==
+        Verdict::kVertical)
       return true;
   }
   return false;
@@ -519,7 +512,7 @@ BoundaryStats FloorBoundaryFinder::find(const FloorGeometry &geometry, const cv:
       // here; or a surface decisively stands on the floor farther out.
       const bool floor_reaches_farther =
           verdict == Verdict::kUndecided && contact != nullptr &&
-          (floor_seen_beyond(index, outer_row, rows_llr) || vertical_beyond(column, inner_edges_here, index));
+          (floor_seen_beyond(index, outer_row, rows_llr) || vertical_beyond(column, index));
       if (verdict == Verdict::kFloor || floor_reaches_farther) {
         ++stats.floor_texture;
         farthest_floor_row = edge.row_subpx;

@@ -1,5 +1,6 @@
 #pragma once
 
+#include <limits>
 #include <opencv2/core.hpp>
 #include <span>
 #include <vector>
@@ -106,9 +107,13 @@ class FloorBoundaryFinder {
   /// floor (the twin's offset from a surface standing at the edge against its offset from
   /// the floor, in units of the frame's placement error).
   [[nodiscard]] bool floor_seen_beyond(std::size_t index, float contact_row, double rows_llr) const;
-  /// Offset of the current column's outer edge of polarity `sign` nearest `outer_row`, at
-  /// most kTwinSearchRows.
-  [[nodiscard]] float twin_offset(float outer_row, int sign) const;
+  /// The current column's outer edge of polarity `sign` nearest `outer_row` and its offset
+  /// from it (nullptr and infinity when the column has none).
+  struct Twin {
+    const vision::EdgePoint *edge = nullptr;
+    float offset = std::numeric_limits<float>::infinity();
+  };
+  [[nodiscard]] Twin nearest_twin(float outer_row, int sign) const;
   [[nodiscard]] float outer_at(float row, int column) const;
   /// One column-major line (a column of a lobe) at a fractional row, clamped to the lobe.
   [[nodiscard]] float interpolate(const float *line, float row) const;
@@ -137,10 +142,9 @@ class FloorBoundaryFinder {
   void measure_twin_spread(const vision::EdgeImage &inner_edges, const vision::EdgeImage &outer_edges,
                            const vision::ColumnEdges &inner_candidates,
                            const vision::ColumnEdges &outer_candidates);
-  /// Whether an edge of `edges` (one column's, nearest first) beyond `index` stands on the
-  /// floor (it has an outer twin there) and is decisively a vertical surface.
-  [[nodiscard]] bool vertical_beyond(int column, std::span<const vision::EdgePoint> edges,
-                                     std::size_t index) const;
+  /// Whether an edge of the current column beyond `index` stands on the floor (it has an
+  /// outer twin there) and is decisively a vertical surface.
+  [[nodiscard]] bool vertical_beyond(int column, std::size_t index) const;
   /// Whether floor up to the farther edge and a surface standing there explain the rows
   /// beyond the nearer base better than a surface standing at the nearer base.
   [[nodiscard]] bool farther_base_explains_better(int column, float base_row, float base_contact_row,
