@@ -220,3 +220,42 @@ TEST_CASE("office-real: carpet edges short of a far wall are floor when the twin
       errors.size(), 100.0 * *middle, static_cast<double>(scan.stats.twin_spread_px));
   CHECK(*middle >= -0.10);
 }
+
+// Each point says how far its range moves per pixel of image error. A floor contact is
+// ranged from one row and the camera height, a table edge by stereo across the 150 mm
+// between the lobes' foci: at the same range the stereo point's moves several times
+// further, and a contact's grows with its range (about as its square).
+TEST_CASE("l-room-1lap-real: range per pixel of floor contacts and of stereo points",
+          "[stereo][floor][dataset]") {
+  const omnislam::test::TruthDataset data =
+      omnislam::test::load_truth_dataset(dataset_dir("l-room-1lap-real"));
+  omnislam::stereo::ScanConfig config;
+  config.camera = data.info.camera;
+  config.camera_height_m = data.info.camera_height_m;
+  omnislam::stereo::ScanReconstructor reconstructor(config);
+  std::vector<double> near_contacts, far_contacts, mid_contacts, mid_stereo;
+  for (std::size_t i = 0; i < data.images.size(); i += 6) {
+    for (const omnislam::stereo::ScanPoint &point : reconstructor.reconstruct(data.images[i]).points) {
+      const double per_px = point.range_per_px_m;
+      REQUIRE(per_px > 0.0);
+      const bool contact = std::abs(point.z_m) < 1e-6;
+      if (contact) REQUIRE(std::isfinite(per_px));
+      if (contact && point.range_m < 1.5) near_contacts.push_back(per_px);
+      if (contact && point.range_m > 3.0) far_contacts.push_back(per_px);
+      if (point.range_m > 2.0 && point.range_m < 3.0) (contact ? mid_contacts : mid_stereo).push_back(per_px);
+    }
+  }
+  auto median = [](std::vector<double> values) {
+    REQUIRE(values.size() >= 10u);
+    const auto middle = values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2);
+    std::nth_element(values.begin(), middle, values.end());
+    return *middle;
+  };
+  const double near = median(near_contacts), far = median(far_contacts);
+  const double contact_2_3 = median(mid_contacts), stereo_2_3 = median(mid_stereo);
+  std::printf(
+      "l-room-1lap-real range per px: contacts < 1.5 m %.4f, > 3 m %.4f, 2-3 m %.4f; stereo 2-3 m %.4f\n",
+      near, far, contact_2_3, stereo_2_3);
+  CHECK(far > 4.0 * near);
+  CHECK(stereo_2_3 > 4.0 * contact_2_3);
+}

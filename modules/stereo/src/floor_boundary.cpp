@@ -547,7 +547,8 @@ BoundaryStats FloorBoundaryFinder::find(const FloorGeometry &geometry, const cv:
       ++stats.floor_contacts;
       if (verdict == Verdict::kUndecided) ++stats.undecided;
       const auto range_m = static_cast<float>(geometry_->floor_range_at(base->row_subpx));
-      BoundaryPoint point{column, base->row_subpx, outer_row, range_m, floor_height_m};
+      BoundaryPoint point{column,  base->row_subpx, outer_row,
+                          range_m, floor_height_m,  config_.floor_plane_range};
       if (!config_.floor_plane_range) {
         const auto stereo = triangulator.triangulate(column, base->row_subpx, outer_row);
         if (!stereo) continue;

@@ -3,7 +3,9 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <numbers>
+#include <optional>
 #include <utility>
 
 #include "omnislam/mirror/panorama_maps.hpp"
@@ -160,15 +162,41 @@ void ScanReconstructor::triangulate(LocalScan &scan) {
   }
 }
 
+double ScanReconstructor::stereo_range_per_px(int column, float inner_row, float outer_row,
+                                              double range_m) const {
+  // Range moved by one pixel of `row`, from the rows half a pixel either side.
+  auto per_px = [&](auto &&range_at, float row) {
+    const std::optional<double> below = range_at(row - 0.5f), above = range_at(row + 0.5f);
+    if (below && above) return *above - *below;
+    if (below) return 2.0 * (range_m - *below);
+    if (above) return 2.0 * (*above - range_m);
+    return std::numeric_limits<double>::infinity();
+  };
+  auto range_of = [](const std::optional<mirror::MeridianPoint> &point) {
+    return point ? std::optional<double>(point->range_m) : std::nullopt;
+  };
+  const double inner = per_px(
+      [&](float row) { return range_of(triangulator_.triangulate(column, row, outer_row)); }, inner_row);
+  const double outer = per_px(
+      [&](float row) { return range_of(triangulator_.triangulate(column, inner_row, row)); }, outer_row);
+  return std::hypot(inner, outer);
+}
+
+double ScanReconstructor::floor_range_per_px(float inner_row) const {
+  return std::abs(floor_geometry_.floor_range_at(inner_row + 0.5) -
+                  floor_geometry_.floor_range_at(inner_row - 0.5));
+}
+
 void ScanReconstructor::add_point(int column, double range_m, double height_m, float inner_row,
-                                  float outer_row, LocalScan &scan) {
+                                  float outer_row, double range_per_px_m, LocalScan &scan) {
   if (range_m < config_.stereo.near_cutoff_m || range_m > config_.stereo.far_cutoff_m) {
     ++scan.stats.outside_cutoffs;
     return;
   }
   const auto c = static_cast<std::size_t>(column);
   scan.points.push_back({column_azimuth_rad_[c], range_m, range_m * column_cos_[c], range_m * column_sin_[c],
-                         config_.camera_height_m + height_m, inner_row, outer_row, column});
+                         config_.camera_height_m + height_m, inner_row, outer_row, column,
+                         static_cast<float>(range_per_px_m)});
 }
 
 void ScanReconstructor::build_boundary_scan(LocalScan &scan) {
@@ -182,7 +210,11 @@ void ScanReconstructor::build_boundary_scan(LocalScan &scan) {
   scan.stats.noise_scale = boundary_stats_.noise_scale;
   scan.stats.twin_spread_px = boundary_stats_.twin_spread_px;
   for (const BoundaryPoint &point : boundary_points_) {
-    add_point(point.column, point.range_m, point.height_m, point.inner_row, point.outer_row, scan);
+    const double range_per_px_m = point.floor_ranged ? floor_range_per_px(point.inner_row)
+                                                     : stereo_range_per_px(point.column, point.inner_row,
+                                                                           point.outer_row, point.range_m);
+    add_point(point.column, point.range_m, point.height_m, point.inner_row, point.outer_row, range_per_px_m,
+              scan);
   }
   // One boundary per column already; the per-degree filter matters only for finer panoramas.
   if (config_.stereo.one_point_per_degree)
@@ -201,7 +233,8 @@ void ScanReconstructor::build_scan(const std::vector<RowMatch> &matches, LocalSc
       ++scan.stats.no_intersection;
       continue;
     }
-    add_point(match.column, point->range_m, point->height_m, match.inner_row, match.outer_row, scan);
+    add_point(match.column, point->range_m, point->height_m, match.inner_row, match.outer_row,
+              stereo_range_per_px(match.column, match.inner_row, match.outer_row, point->range_m), scan);
   }
   if (stereo.one_point_per_degree) scan.stats.filtered_out = keep_nearest_per_degree(scan.points, filtered_);
   scan.stats.points = static_cast<int>(scan.points.size());

@@ -63,7 +63,8 @@ struct BoundaryPoint {
   float inner_row = 0.0f;
   float outer_row = 0.0f;
   double range_m = 0.0;
-  double height_m = 0.0;  ///< relative to the pinhole (the floor is -camera_height_m for a contact)
+  double height_m = 0.0;      ///< relative to the pinhole (the floor is -camera_height_m for a contact)
+  bool floor_ranged = false;  ///< ranged from the floor plane (inner row only), not by stereo
 };
 
 struct BoundaryStats {

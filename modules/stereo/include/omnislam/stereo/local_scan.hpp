@@ -18,6 +18,11 @@ struct ScanPoint {
   float inner_row = 0.0f;  ///< matched panorama rows (fractional after sub-pixel refinement)
   float outer_row = 0.0f;
   int column = 0;  ///< the panorama column the point was found in
+  /// How far the range moves per pixel of error in the rows that placed it (m/px): the
+  /// floor plane's slope at the row for a floor contact, both rows' effect combined for a
+  /// stereo point; infinite when half a pixel already loses the intersection. The
+  /// registration weighs points by it (slam/trimmed_icp.hpp).
+  float range_per_px_m = 0.0f;
 };
 
 /// Counts after each step of the reconstruction, for logs, profiles and tests.

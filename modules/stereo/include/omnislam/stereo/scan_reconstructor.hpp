@@ -76,7 +76,14 @@ class ScanReconstructor {
   }
   void build_boundary_scan(LocalScan &scan);
   void add_point(int column, double range_m, double height_m, float inner_row, float outer_row,
-                 LocalScan &scan);
+                 double range_per_px_m, LocalScan &scan);
+  /// ScanPoint::range_per_px_m of a stereo point: the range's central difference over one
+  /// pixel of each row (one-sided where the other side loses the intersection), combined
+  /// as independent errors; infinite when neither side of a row intersects.
+  [[nodiscard]] double stereo_range_per_px(int column, float inner_row, float outer_row,
+                                           double range_m) const;
+  /// The same for a floor contact ranged from the inner row and the floor plane.
+  [[nodiscard]] double floor_range_per_px(float inner_row) const;
 
   ScanConfig config_;
   mirror::MirrorModel model_;
