@@ -68,8 +68,12 @@ Result sequential_reference(const Input &in) {
     reconstructor.match();
     reconstructor.triangulate(scan);
     slam::Points2 points;
-    for (const stereo::ScanPoint &p : scan.points) points.emplace_back(p.x_m, p.y_m);
-    result.estimates.push_back(slam.process(points, in.odometry[static_cast<std::size_t>(i)]));
+    std::vector<double> range_per_px;
+    for (const stereo::ScanPoint &p : scan.points) {
+      points.emplace_back(p.x_m, p.y_m);
+      range_per_px.push_back(p.range_per_px_m);
+    }
+    result.estimates.push_back(slam.process(points, in.odometry[static_cast<std::size_t>(i)], range_per_px));
     result.scan_sizes.push_back(scan.points.size());
   }
   result.map = slam.map().points();

@@ -191,3 +191,62 @@ TEST_CASE("trimmed ICP: the predictive covariance is the t's, dof / (dof - 2) ti
   // Fewer than three would have no finite variance: three are assumed.
   CHECK(predictive_covariance(estimate, 1.0).isApprox(estimate * 3.0));
 }
+
+TEST_CASE("trimmed ICP: points weighed by their range error per pixel outweigh the imprecise ones",
+          "[slam][icp][weights]") {
+  // A scan whose every second point is ranged by stereo (a short baseline: 0.25 m of range per
+  // pixel, read 2% short, as table edges are) and the rest by the floor plane (range per pixel
+  // growing with the square of the range); 0.3 px of image noise on every point. Told each
+  // point's range per pixel, the registration fits the noise model to its own residuals and
+  // the imprecise half no longer pulls the pose (plain 3.4 mm, weighted 1.3 mm here).
+  const auto walls = omnislam::test::l_room();
+  const Eigen::Isometry2d T_map_model = pose(1.0, 1.0, 0.0);
+  const Eigen::Isometry2d T_map_sample = pose(1.2, 0.9, 0.05);
+  const Eigen::Isometry2d truth = T_map_model.inverse() * T_map_sample;
+  double plain_error_m = 0.0, weighted_error_m = 0.0;
+  constexpr int kTrials = 10;
+  for (int trial = 0; trial < kTrials; ++trial) {
+    std::mt19937_64 rng(100 + trial);
+    const Points2 model = omnislam::test::scan_from(walls, T_map_model, rng, 0.002, 5.0);
+    Points2 sample = omnislam::test::scan_from(walls, T_map_sample, rng, 0.0, 5.0);
+    std::normal_distribution<double> pixels(0.0, 0.3);
+    std::vector<double> range_per_px(sample.size());
+    for (std::size_t i = 0; i < sample.size(); ++i) {
+      const double range_m = sample[i].norm();
+      const bool stereo = i % 2 == 0;
+      range_per_px[i] = stereo ? 0.25 : 0.005 * range_m * range_m;
+      const double read_m = (stereo ? 0.98 * range_m : range_m) + range_per_px[i] * pixels(rng);
+      sample[i] *= read_m / range_m;
+    }
+    const Eigen::Isometry2d guess = truth * pose(0.03, -0.02, 0.01);
+    const auto plain = register_trimmed_icp(NearestNeighbors(model), sample, guess);
+    const auto weighted =
+        register_trimmed_icp(NearestNeighbors(model), sample, guess, {}, nullptr, range_per_px);
+    REQUIRE(plain.valid);
+    REQUIRE(weighted.valid);
+    CHECK(plain.range_noise_ratio == 0.0);
+    CHECK(weighted.range_noise_ratio > 0.0);
+    plain_error_m += (truth.inverse() * plain.T_model_sample).translation().norm() / kTrials;
+    weighted_error_m += (truth.inverse() * weighted.T_model_sample).translation().norm() / kTrials;
+  }
+  INFO("mean position error: plain " << plain_error_m << " m, weighted " << weighted_error_m << " m");
+  CHECK(weighted_error_m < 0.5 * plain_error_m);
+  CHECK(weighted_error_m < 0.01);
+}
+
+TEST_CASE("trimmed ICP: no reweighting without range errors or with no passes", "[slam][icp][weights]") {
+  const auto walls = omnislam::test::l_room();
+  std::mt19937_64 rng(3);
+  const Points2 model = omnislam::test::scan_from(walls, pose(1.0, 1.0, 0.0), rng, 0.005);
+  const Points2 sample = omnislam::test::scan_from(walls, pose(1.1, 1.0, 0.02), rng, 0.005);
+  const std::vector<double> range_per_px(sample.size(), 0.05);
+  omnislam::slam::TrimmedIcpConfig no_passes;
+  no_passes.range_weighting_passes = 0;
+  const Eigen::Isometry2d guess = pose(0.1, 0.0, 0.02);
+  const auto plain = register_trimmed_icp(NearestNeighbors(model), sample, guess);
+  const auto unweighted =
+      register_trimmed_icp(NearestNeighbors(model), sample, guess, no_passes, nullptr, range_per_px);
+  CHECK(unweighted.range_noise_ratio == 0.0);
+  CHECK(unweighted.T_model_sample.isApprox(plain.T_model_sample, 0.0));
+  CHECK(unweighted.covariance.isApprox(plain.covariance, 0.0));
+}

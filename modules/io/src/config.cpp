@@ -254,6 +254,7 @@ void read_slam(YamlSection &section, slam::SlamConfig &slam) {
   section.read("estimate_scale", slam.icp.estimate_scale);
   section.read("keep_global_minimum", slam.icp.keep_global_minimum);
   section.read("covariance_sectors", slam.icp.covariance_sectors);
+  section.read("range_weighting_passes", slam.icp.range_weighting_passes);
   section.read("use_srel_test", slam.use_srel_test);
   section.read("srel_limit_percent", slam.srel_limit_percent);
   section.read("srel_relax_percent", slam.srel_relax_percent);
@@ -281,6 +282,8 @@ void read_slam(YamlSection &section, slam::SlamConfig &slam) {
   if (!(slam.icp.initial_search_radius_m > 0.0)) section.fail("initial_search_radius_m", "must be positive");
   if (slam.icp.covariance_sectors < 1 || slam.icp.covariance_sectors > 360)
     section.fail("covariance_sectors", "must be in 1..360");
+  if (slam.icp.range_weighting_passes < 0 || slam.icp.range_weighting_passes > 10)
+    section.fail("range_weighting_passes", "must be in 0..10");
   if (slam.icp.max_iterations < 1 || slam.icp.max_iterations > 1000) {
     section.fail("max_iterations", "must be in 1..1000");
   }

@@ -41,6 +41,13 @@ slam::Points2 scan_points(const stereo::LocalScan &scan) {
   return points;
 }
 
+std::vector<double> scan_range_per_px(const stereo::LocalScan &scan) {
+  std::vector<double> ranges;
+  ranges.reserve(scan.points.size());
+  for (const stereo::ScanPoint &p : scan.points) ranges.push_back(p.range_per_px_m);
+  return ranges;
+}
+
 bool background_loop_closure(const PipelineConfig &config) {
   switch (config.loop_closure) {
     case LoopClosureThread::kInline:
@@ -317,7 +324,7 @@ void Pipeline::slam_loop() {
           slam_.apply_loop_result(std::move(*result));
       }
       if (frame->pose_reset) slam_.set_pose(frame->pose_reset->T_map_base, frame->pose_reset->covariance);
-      frame->estimate = slam_.process(scan_points(frame->scan), odometry);
+      frame->estimate = slam_.process(scan_points(frame->scan), odometry, scan_range_per_px(frame->scan));
       if (loop_closer_) {
         if (std::optional<slam::LoopJob> job = slam_.take_loop_job()) loop_closer_->submit(std::move(*job));
         loop_jobs_done_.store(loop_closer_->jobs_done(), std::memory_order_relaxed);

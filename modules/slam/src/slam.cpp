@@ -118,7 +118,8 @@ double Slam::registration_reach_m(const Points2 &scan_base) const {
          kNormalRadiusM;
 }
 
-FrameEstimate Slam::register_scan(const Points2 &scan_base, const Eigen::Isometry2d &predicted) {
+FrameEstimate Slam::register_scan(const Points2 &scan_base, const Eigen::Isometry2d &predicted,
+                                  std::span<const double> range_per_px_m) {
   const double srel_limit = config_.srel_limit_percent + relaxation_percent_;
   auto accepted = [&](const TrimmedIcpResult &r, const Eigen::Isometry2d &pose) {
     return config_.use_odometry ? accept(r, predicted, pose, srel_limit)
@@ -130,7 +131,8 @@ FrameEstimate Slam::register_scan(const Points2 &scan_base, const Eigen::Isometr
   const PosePrior prior{predicted, prediction_covariance_.topLeftCorner<2, 2>()};
   const PosePrior *use_prior = predicted_by_odometry_ && config_.odometry_prior ? &prior : nullptr;
   auto try_forward = [&](const NearestNeighbors &model, Attempt attempt) {
-    const TrimmedIcpResult r = register_trimmed_icp(model, scan_base, predicted, config_.icp, use_prior);
+    const TrimmedIcpResult r =
+        register_trimmed_icp(model, scan_base, predicted, config_.icp, use_prior, range_per_px_m);
     estimate.registration = r;
     if (!accepted(r, r.T_model_sample)) return false;
     estimate = {r.T_model_sample, true, attempt, r, r.covariance};
@@ -342,7 +344,8 @@ void Slam::apply_loop_result(LoopResult result) {
   for (Points2 &scan : recent_scans_map_) scan = transformed(scan, T_corrected_tracked);
 }
 
-FrameEstimate Slam::process(const Points2 &scan_base, const std::optional<Eigen::Isometry2d> &T_odom_base) {
+FrameEstimate Slam::process(const Points2 &scan_base, const std::optional<Eigen::Isometry2d> &T_odom_base,
+                            std::span<const double> range_per_px_m) {
   const bool first = !started_;
   started_ = true;
   if (first && map_.empty() && !config_.localization_only) {
@@ -371,7 +374,7 @@ FrameEstimate Slam::process(const Points2 &scan_base, const std::optional<Eigen:
   FrameEstimate estimate;
   estimate.T_map_base = predicted;
   if (static_cast<int>(scan_base.size()) >= config_.min_scan_points)
-    estimate = register_scan(scan_base, predicted);
+    estimate = register_scan(scan_base, predicted, range_per_px_m);
 
   if (estimate.integrated && previous_failed_ && config_.optional_map_correction &&
       config_.target == RegistrationTarget::kPreviousScan) {

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <limits>
 #include <numbers>
+#include <span>
 #include <vector>
 
 namespace omnislam::slam {
@@ -21,12 +22,21 @@ struct Pair {
   Point2 normal;  ///< model normal, zero when unknown (then the pair is point-to-point)
   Point2 sample;  ///< original (untransformed) sample point
   double residual_sq_m2;
+  double weight = 1.0;   ///< relative to a point without range error (1 when unweighted)
+  double lever_m = 0.0;  ///< b: the sample point's range per pixel along the residual
 };
 
 struct Motion {
   Eigen::Isometry2d T = Eigen::Isometry2d::Identity();
   double scale = 1.0;
   [[nodiscard]] Point2 apply(const Point2 &p) const { return T.linear() * (scale * p) + T.translation(); }
+};
+
+// How the pairs are weighted: 1 / (1 + ratio b^2), b the sample point's range per pixel
+// along the residual; ratio 0 weighs every pair alike (the plain fit).
+struct Weighting {
+  std::span<const double> range_per_px_m;  ///< empty: no range errors known (b = 0)
+  double ratio = 0.0;
 };
 
 double residual_sq(const Point2 &moved, const Point2 &model, const Point2 &normal, IcpMetric metric) {
@@ -37,24 +47,43 @@ double residual_sq(const Point2 &moved, const Point2 &model, const Point2 &norma
   return (moved - model).squaredNorm();
 }
 
+// b of sample point `p`: its range per pixel times the share of a range error that moves
+// the residual (the ray's cosine to the model normal; all of it for a point-to-point pair).
+double lever_m(const Point2 &p, const Motion &motion, const Point2 &normal, double range_per_px_m) {
+  const double range_m = p.norm();
+  if (normal.isZero() || !(range_m > 0.0)) return range_per_px_m;
+  const double along = std::abs(normal.dot(motion.T.linear() * p)) / range_m;
+  return along > 0.0 ? range_per_px_m * along : 0.0;  // an infinite range error across the ray moves nothing
+}
+
 // Steps 1-3 of Chetverikov 2002: pair every transformed sample point with its nearest
-// model point inside dmax, sort by residual and keep the best overlap * N_p.
+// model point inside dmax, sort by (weighted) residual and keep the best overlap * N_p.
 std::vector<Pair> trimmed_pairs(const NearestNeighbors &model, const Points2 &sample, const Motion &motion,
-                                double search_radius_m, const TrimmedIcpConfig &config) {
+                                double search_radius_m, const TrimmedIcpConfig &config,
+                                const Weighting &weighting) {
   const bool with_normals = config.metric == IcpMetric::kPointToLine;
+  const bool with_levers = weighting.range_per_px_m.size() == sample.size();
   std::vector<Pair> pairs;
   pairs.reserve(sample.size());
-  for (const Point2 &p : sample) {
+  for (std::size_t i = 0; i < sample.size(); ++i) {
+    const Point2 &p = sample[i];
     const Point2 moved = motion.apply(p);
     if (const auto hit = model.nearest(moved, search_radius_m)) {
       const Point2 &m = model.points()[hit->index];
       const Point2 normal = with_normals ? model.normal(hit->index) : Point2::Zero();
-      pairs.push_back({m, normal, p, residual_sq(moved, m, normal, config.metric)});
+      Pair pair{m, normal, p, residual_sq(moved, m, normal, config.metric)};
+      if (with_levers) pair.lever_m = lever_m(p, motion, normal, weighting.range_per_px_m[i]);
+      if (weighting.ratio > 0.0) {
+        pair.weight = 1.0 / (1.0 + weighting.ratio * pair.lever_m * pair.lever_m);
+        if (!(pair.weight > 0.0)) continue;  // a range unknown to within a pixel tells nothing
+      }
+      pairs.push_back(pair);
     }
   }
   const auto keep = std::min(pairs.size(), static_cast<std::size_t>(config.overlap * sample.size()));
-  std::nth_element(pairs.begin(), pairs.begin() + static_cast<std::ptrdiff_t>(keep), pairs.end(),
-                   [](const Pair &a, const Pair &b) { return a.residual_sq_m2 < b.residual_sq_m2; });
+  std::nth_element(
+      pairs.begin(), pairs.begin() + static_cast<std::ptrdiff_t>(keep), pairs.end(),
+      [](const Pair &a, const Pair &b) { return a.weight * a.residual_sq_m2 < b.weight * b.residual_sq_m2; });
   pairs.resize(keep);
   return pairs;
 }
@@ -98,9 +127,10 @@ NormalEquations pair_terms(const Pair &pair, const Motion &motion) {
   J << 1.0, 0.0, -moved.y(), 0.0, 1.0, moved.x();
   if (!pair.normal.isZero()) {
     const Eigen::RowVector3d row = pair.normal.transpose() * J;
-    return {row.transpose() * row, row.transpose() * pair.normal.dot(moved - pair.model)};
+    return {pair.weight * row.transpose() * row,
+            pair.weight * row.transpose() * pair.normal.dot(moved - pair.model)};
   }
-  return {J.transpose() * J, J.transpose() * (moved - pair.model)};
+  return {pair.weight * J.transpose() * J, pair.weight * J.transpose() * (moved - pair.model)};
 }
 
 NormalEquations normal_equations(const std::vector<Pair> &pairs, const Motion &motion) {
@@ -137,10 +167,46 @@ Motion point_to_line_motion(const std::vector<Pair> &pairs, const Motion &curren
   return {step * current.T, 1.0};
 }
 
+// e: the pairs' mean squared residual, each weighted (so with weights, the residual
+// variance of a point without range error).
 double mean_sq(const std::vector<Pair> &pairs) {
   double sum = 0.0;
-  for (const Pair &pair : pairs) sum += pair.residual_sq_m2;
+  for (const Pair &pair : pairs) sum += pair.weight * pair.residual_sq_m2;
   return pairs.empty() ? 0.0 : sum / static_cast<double>(pairs.size());
+}
+
+// The pairs' squared residuals modelled as s0^2 + k b^2 (a part every pair has, and the
+// range error's, k the variance of the image error in px^2): least squares on the squares,
+// each weighted by its variance under the model (2 (s0^2 + k b^2)^2 for a Gaussian
+// residual), refitted from the plain mean. Returns k / s0^2, 0 when the residuals show no
+// range part.
+double range_noise_ratio(const std::vector<Pair> &pairs) {
+  constexpr int kRefits = 4;
+  double s0_sq = std::max(mean_sq(pairs), kMinResidualVarianceM2), k = 0.0;
+  for (int refit = 0; refit < kRefits; ++refit) {
+    Eigen::Matrix2d A = Eigen::Matrix2d::Zero();
+    Eigen::Vector2d y = Eigen::Vector2d::Zero();
+    for (const Pair &pair : pairs) {
+      const double b_sq = pair.lever_m * pair.lever_m;
+      if (!std::isfinite(b_sq)) continue;
+      const double variance = s0_sq + k * b_sq;
+      const Eigen::Vector2d x(1.0, b_sq);
+      A += x * x.transpose() / (variance * variance);
+      y += x * pair.residual_sq_m2 / (variance * variance);
+    }
+    if (std::abs(A.determinant()) <= 1e-12 * A.squaredNorm()) return 0.0;
+    const Eigen::Vector2d fit = A.ldlt().solve(y);
+    if (!fit.allFinite() || !(fit.y() > 0.0)) return 0.0;
+    s0_sq = fit.x();
+    k = fit.y();
+    if (s0_sq < kMinResidualVarianceM2) {
+      // The common part at its floor, the range part refitted alone.
+      s0_sq = kMinResidualVarianceM2;
+      k = std::max(0.0, (y.y() - A(1, 0) * s0_sq) / A(1, 1));
+      if (!(k > 0.0)) return 0.0;
+    }
+  }
+  return k / s0_sq;
 }
 
 // Covariance of (x, y, yaw): sigma^2 (J^T J)^-1 with sigma^2 the residual variance.
@@ -241,40 +307,49 @@ RobustCovariance robust_covariance_of(const std::vector<Pair> &pairs, const Moti
           clusters - 1.0};
 }
 
-}  // namespace
+// One run of the trimmed ICP loop from `start` under a fixed weighting.
+struct Pass {
+  bool valid = false;
+  bool converged = false;
+  int iterations = 0;
+  double first_error_m2 = 0.0;
+  double final_error_m2 = 0.0;   ///< e at `returned` (weighted as the pass was)
+  double search_radius_m = 0.0;  ///< dmax the returned pairs were found with
+  Motion returned;
+  std::vector<Pair> pairs;  ///< at `returned`
+};
 
-TrimmedIcpResult register_trimmed_icp(const NearestNeighbors &model, const Points2 &sample,
-                                      const Eigen::Isometry2d &initial_guess, const TrimmedIcpConfig &config,
-                                      const PosePrior *prior) {
-  TrimmedIcpResult result;
-  result.T_model_sample = initial_guess;
-  result.sample_points = sample.size();
-  if (model.empty() || sample.size() < 3) return result;
-
-  Motion current{initial_guess, 1.0};
+Pass iterate(const NearestNeighbors &model, const Points2 &sample, const Motion &start,
+             const TrimmedIcpConfig &config, const PosePrior *prior, const Weighting &weighting) {
+  Pass pass;
+  Motion current = start;
   Motion evaluated = current;  // the motion at which the last error was measured
   Motion best = current;
   double best_error = std::numeric_limits<double>::infinity();
+  double best_radius = config.initial_search_radius_m;
   double previous_error = std::numeric_limits<double>::infinity();
   double search_radius = config.initial_search_radius_m;
+  double evaluated_radius = search_radius;
   std::vector<Pair> pairs, best_pairs;
 
   for (int iteration = 0; iteration < config.max_iterations; ++iteration) {
-    pairs = trimmed_pairs(model, sample, current, search_radius, config);
+    pairs = trimmed_pairs(model, sample, current, search_radius, config, weighting);
     if (pairs.size() < 3) break;
     evaluated = current;
+    evaluated_radius = search_radius;
     const double error = mean_sq(pairs);
-    if (iteration == 0) result.first_error_m2 = error;
-    result.iterations = iteration + 1;
-    result.final_error_m2 = error;
+    if (iteration == 0) pass.first_error_m2 = error;
+    pass.iterations = iteration + 1;
+    pass.final_error_m2 = error;
     if (error < best_error) {
       best_error = error;
       best = current;
       best_pairs = pairs;
+      best_radius = search_radius;
     }
     if (error <= config.target_error_m2 ||
         (iteration > 0 && std::abs(previous_error - error) <= config.min_relative_change * previous_error)) {
-      result.converged = true;
+      pass.converged = true;
       break;
     }
     previous_error = error;
@@ -287,28 +362,73 @@ TrimmedIcpResult register_trimmed_icp(const NearestNeighbors &model, const Point
                   ? point_to_line_motion(pairs, current, prior, std::max(error, kMinResidualVarianceM2))
                   : horn_motion(pairs, config.estimate_scale);
   }
-  if (best_pairs.empty()) return result;
+  if (best_pairs.empty()) return pass;
 
   // The thesis keeps the global minimum and returns it when the last e is > 10% above it.
-  Motion returned = evaluated;
-  if (config.keep_global_minimum && result.final_error_m2 > 1.1 * best_error) {
-    returned = best;
+  pass.returned = evaluated;
+  pass.search_radius_m = evaluated_radius;
+  if (config.keep_global_minimum && pass.final_error_m2 > 1.1 * best_error) {
+    pass.returned = best;
     pairs = best_pairs;
-    result.final_error_m2 = best_error;
+    pass.final_error_m2 = best_error;
+    pass.search_radius_m = best_radius;
   }
+  pass.pairs = std::move(pairs);
+  pass.valid = true;
+  return pass;
+}
+
+}  // namespace
+
+TrimmedIcpResult register_trimmed_icp(const NearestNeighbors &model, const Points2 &sample,
+                                      const Eigen::Isometry2d &initial_guess, const TrimmedIcpConfig &config,
+                                      const PosePrior *prior, std::span<const double> sample_range_per_px_m) {
+  TrimmedIcpResult result;
+  result.T_model_sample = initial_guess;
+  result.sample_points = sample.size();
+  if (model.empty() || sample.size() < 3) return result;
+
+  const std::span<const double> ranges =
+      sample_range_per_px_m.size() == sample.size() ? sample_range_per_px_m : std::span<const double>{};
+  Pass pass = iterate(model, sample, {initial_guess, 1.0}, config, prior, {ranges, 0.0});
+  if (!pass.valid) return result;
+  result.first_error_m2 = pass.first_error_m2;
+  result.iterations = pass.iterations;
+  result.converged = pass.converged;
+  // Reweighted by the range-noise model the pairs themselves show, from the last fit.
+  bool weighted = false;
+  if (config.metric == IcpMetric::kPointToLine && !ranges.empty()) {
+    for (int i = 0; i < config.range_weighting_passes; ++i) {
+      const double ratio = range_noise_ratio(pass.pairs);
+      if (!(ratio > 0.0)) break;
+      Pass next = iterate(model, sample, pass.returned, config, prior, {ranges, ratio});
+      if (!next.valid) break;
+      result.iterations += next.iterations;
+      result.converged = next.converged;
+      result.range_noise_ratio = ratio;
+      pass = std::move(next);
+      weighted = true;
+    }
+  }
+  const Motion &returned = pass.returned;
   result.valid = true;
   result.T_model_sample = returned.T;
   result.scale = returned.scale;
-  result.kept_pairs = pairs.size();
+  // The fit's measures stay the plain trimmed ones (what the acceptance tests judge).
+  const std::vector<Pair> plain =
+      weighted ? trimmed_pairs(model, sample, returned, pass.search_radius_m, config, {}) : pass.pairs;
+  result.final_error_m2 = weighted ? mean_sq(plain) : pass.final_error_m2;
+  result.kept_pairs = plain.size();
   result.srel_percent = result.first_error_m2 > 0.0
                             ? 100.0 * (result.first_error_m2 - result.final_error_m2) / result.first_error_m2
                             : 0.0;
   std::size_t inliers = 0;
   for (const Point2 &p : sample) inliers += model.nearest(returned.apply(p), kInlierDistanceM) ? 1 : 0;
   result.inlier_share = static_cast<double>(inliers) / static_cast<double>(sample.size());
-  result.covariance = covariance_of(pairs, returned, result.final_error_m2);
+  // The covariance from the pairs as weighted: a pair's residual variance is e / weight.
+  result.covariance = covariance_of(pass.pairs, returned, pass.final_error_m2);
   const RobustCovariance robust =
-      robust_covariance_of(pairs, returned, config.covariance_sectors, result.covariance);
+      robust_covariance_of(pass.pairs, returned, config.covariance_sectors, result.covariance);
   result.robust_covariance = robust.covariance;
   result.covariance_dof = robust.dof;
   return result;

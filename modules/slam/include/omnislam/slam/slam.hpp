@@ -6,6 +6,7 @@
 #include <limits>
 #include <memory>
 #include <optional>
+#include <span>
 
 #include "omnislam/slam/keyframe_graph.hpp"
 #include "omnislam/slam/loop_closure.hpp"
@@ -121,8 +122,13 @@ class Slam {
   /// map (along a corridor a scan fits anywhere). The odometry chain is kept across the
   /// gap: the next frame with odometry is predicted from the last frame that had odometry,
   /// so no motion is counted twice or lost.
+  ///
+  /// `range_per_px_m`, empty or one per scan point, is how far each point's range moves per
+  /// pixel of image error; given, the registration against the map weighs the points by
+  /// it (TrimmedIcpConfig::range_weighting_passes).
   [[nodiscard]] FrameEstimate process(const Points2 &scan_base,
-                                      const std::optional<Eigen::Isometry2d> &T_odom_base);
+                                      const std::optional<Eigen::Isometry2d> &T_odom_base,
+                                      std::span<const double> range_per_px_m = {});
 
   /// Continues from a saved state (map points with their integration count, and the last
   /// pose with its (x, y, yaw) covariance) instead of starting a new map. With the saved
@@ -183,7 +189,8 @@ class Slam {
   /// advances the random walk it is made of (walk_covariance_) to this frame.
   [[nodiscard]] Eigen::Matrix3d published_covariance(const FrameEstimate &estimate,
                                                      const Eigen::Isometry2d &step);
-  [[nodiscard]] FrameEstimate register_scan(const Points2 &scan_base, const Eigen::Isometry2d &predicted);
+  [[nodiscard]] FrameEstimate register_scan(const Points2 &scan_base, const Eigen::Isometry2d &predicted,
+                                            std::span<const double> range_per_px_m);
   /// How far beyond a scan at its predicted pose the map must be indexed for a registration
   /// to see all it would see in the whole map: the first search radius, the largest
   /// correction accepted (its translation, and its rotation swinging the scan's farthest

@@ -3,6 +3,7 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 #include <cstddef>
+#include <span>
 
 #include "omnislam/slam/nearest_neighbors.hpp"
 
@@ -33,6 +34,13 @@ struct TrimmedIcpConfig {
   /// Bearing sectors of the sample frame whose pairs' residuals robust_covariance treats as
   /// possibly correlated (one cluster each); 45 deg is about one wall seen from inside a room.
   int covariance_sectors = 8;
+  /// Reweighting passes when the sample's range errors per pixel are given (point-to-line
+  /// only): after a plain fit, the pairs' squared residuals are modelled as s0^2 + k b^2,
+  /// with b the point's range per pixel projected on the model normal, the two variances
+  /// fitted to the pairs themselves; the fit is repeated with each pair weighted by
+  /// s0^2 / (s0^2 + k b^2). A point ranged by stereo at 3 m moves ~8x further per pixel
+  /// than a floor contact there, and far points further than near ones. 0: unweighted.
+  int range_weighting_passes = 2;
 };
 
 struct TrimmedIcpResult {
@@ -59,6 +67,9 @@ struct TrimmedIcpResult {
   /// less three where the independent estimate stands in. Eight sectors give seven: the
   /// estimate itself is uncertain (predictive_covariance).
   double covariance_dof = 0.0;
+  /// The range-noise model of the last reweighting pass, k / s0^2 in (px/m)^2: a pair's
+  /// weight was 1 / (1 + range_noise_ratio b^2). 0 when the fit was unweighted.
+  double range_noise_ratio = 0.0;
 };
 
 /// Fewest degrees of freedom predictive_covariance assumes (a t with fewer has no variance).
@@ -87,9 +98,14 @@ struct PosePrior {
 
 /// Registers `sample` onto `model`, starting from `initial_guess`. Degenerate inputs
 /// (empty sets, fewer than 3 pairs) return valid = false with the initial guess.
+/// `sample_range_per_px_m`, empty or one per sample point, is how far each point's range
+/// moves per pixel of image error (stereo::ScanPoint::range_per_px_m); given, the pairs are
+/// weighted by it (TrimmedIcpConfig::range_weighting_passes). final_error_m2, srel_percent,
+/// kept_pairs and inlier_share stay unweighted measures of the returned transform.
 [[nodiscard]] TrimmedIcpResult register_trimmed_icp(const NearestNeighbors &model, const Points2 &sample,
                                                     const Eigen::Isometry2d &initial_guess,
                                                     const TrimmedIcpConfig &config = {},
-                                                    const PosePrior *prior = nullptr);
+                                                    const PosePrior *prior = nullptr,
+                                                    std::span<const double> sample_range_per_px_m = {});
 
 }  // namespace omnislam::slam
