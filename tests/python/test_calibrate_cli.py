@@ -82,12 +82,27 @@ def test_replay_of_an_offset_rig_with_its_rim_centre_matches_the_designed_rig(tm
     centre = re.search(r"center_px: \[[0-9., ]+\]", rim.read_text()).group(0)
     text = (dataset / "dataset.yaml").read_text()
     (dataset / "dataset.yaml").write_text(re.sub(r"center_px: \[[0-9., ]+\]", centre, text))
+    # The same shifted images with the centre they truly have: the best any calibration gives.
+    truth = tmp_path / "sim-room-37-offset-true"
+    truth.mkdir()
+    for path in dataset.iterdir():
+        if path.name != "images":
+            shutil.copy(path, truth / path.name)
+    (truth / "images").symlink_to(dataset / "images")
+    u, v = map(float, re.search(r"center_px: \[([0-9.]+), *([0-9.]+)\]", text).groups())
+    (truth / "dataset.yaml").write_text(
+        re.sub(r"center_px: \[[0-9., ]+\]", f"center_px: [{u + 1.2}, {v - 0.8}]", text))
     designed_max, designed_map = replay_and_evaluate(source, tmp_path / "designed")
     offset_max, offset_map = replay_and_evaluate(dataset, tmp_path / "offset")
+    true_max, true_map = replay_and_evaluate(truth, tmp_path / "true")
     print(f"designed rig: max {designed_max:.4f} m, map {designed_map:.4f} m; "
-          f"offset rig, rim centre: max {offset_max:.4f} m, map {offset_map:.4f} m")
+          f"offset rig, rim centre: max {offset_max:.4f} m, map {offset_map:.4f} m; "
+          f"offset rig, true centre: max {true_max:.4f} m, map {true_map:.4f} m")
     # Within 15%, or within 1.5 mm where 15% is below what any change of the images moves
     # these millimetre figures (measured 2026-12-02: designed 5.9 mm, offset rig with the rim
-    # centre 6.9 mm, +17%; before the odometry prior 7.3 and 6.0 mm).
-    assert offset_max <= max(1.15 * designed_max, designed_max + 0.0015)
-    assert offset_map <= max(1.15 * designed_map, designed_map + 0.0015)
+    # centre 6.9 mm, +17%; before the odometry prior 7.3 and 6.0 mm). Since the registration
+    # weighs points by their range error (2026-12-03) the designed rig's run is 4.7 mm and the
+    # shifted images' are not better (rim centre 6.9 mm, true centre 6.5 mm): so, too, at most
+    # 15% above the run with the true centre, which is what the rim method is to find.
+    assert offset_max <= max(1.15 * designed_max, designed_max + 0.0015, 1.15 * true_max)
+    assert offset_map <= max(1.15 * designed_map, designed_map + 0.0015, 1.15 * true_map)

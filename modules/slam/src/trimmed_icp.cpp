@@ -57,7 +57,10 @@ double lever_m(const Point2 &p, const Motion &motion, const Point2 &normal, doub
 }
 
 // Steps 1-3 of Chetverikov 2002: pair every transformed sample point with its nearest
-// model point inside dmax, sort by (weighted) residual and keep the best overlap * N_p.
+// model point inside dmax, sort by residual and keep the best overlap * N_p. The trimming
+// stays geometric with weights too: sorted by weighted residual, a far point's wrong pair
+// passes for a good one and a near point's pair is dropped (tried: sim-room-37 with more
+// table tops lost 42 mm in one frame).
 std::vector<Pair> trimmed_pairs(const NearestNeighbors &model, const Points2 &sample, const Motion &motion,
                                 double search_radius_m, const TrimmedIcpConfig &config,
                                 const Weighting &weighting) {
@@ -81,9 +84,8 @@ std::vector<Pair> trimmed_pairs(const NearestNeighbors &model, const Points2 &sa
     }
   }
   const auto keep = std::min(pairs.size(), static_cast<std::size_t>(config.overlap * sample.size()));
-  std::nth_element(
-      pairs.begin(), pairs.begin() + static_cast<std::ptrdiff_t>(keep), pairs.end(),
-      [](const Pair &a, const Pair &b) { return a.weight * a.residual_sq_m2 < b.weight * b.residual_sq_m2; });
+  std::nth_element(pairs.begin(), pairs.begin() + static_cast<std::ptrdiff_t>(keep), pairs.end(),
+                   [](const Pair &a, const Pair &b) { return a.residual_sq_m2 < b.residual_sq_m2; });
   pairs.resize(keep);
   return pairs;
 }
