@@ -22,6 +22,14 @@ std::filesystem::path dataset_dir(const char *name) {
   return std::filesystem::path(root != nullptr ? root : OMNISLAM_DEFAULT_DATASETS) / name;
 }
 
+// The front-end's configuration for a dataset: its camera and camera height, the rest default.
+omnislam::stereo::ScanConfig scan_config_of(const omnislam::test::TruthDataset &data) {
+  omnislam::stereo::ScanConfig config;
+  config.camera = data.info.camera;
+  config.camera_height_m = data.info.camera_height_m;
+  return config;
+}
+
 // `camera` replaces the dataset's camera and rig; `first` > 0 scans only the first frames.
 omnislam::test::ScanAccuracy scan_accuracy(const char *name, std::size_t frames, bool degraded,
                                            const std::optional<omnislam::mirror::MirrorConfig> &camera = {},
@@ -32,9 +40,8 @@ omnislam::test::ScanAccuracy scan_accuracy(const char *name, std::size_t frames,
   const omnislam::test::TruthDataset data = omnislam::test::load_truth_dataset(dir);
   REQUIRE(data.images.size() == frames);
 
-  omnislam::stereo::ScanConfig config;
-  config.camera = camera.value_or(data.info.camera);
-  config.camera_height_m = data.info.camera_height_m;
+  omnislam::stereo::ScanConfig config = scan_config_of(data);
+  if (camera) config.camera = *camera;
   omnislam::stereo::ScanReconstructor reconstructor(config);
   // Every factor of the degradation stage at its default, seed 1 (as replay --degrade all).
   const omnislam::degrade::Degrader degrader({}, data.images.front().size());
@@ -160,10 +167,7 @@ TEST_CASE("sim-room-37-real: the twin spread measures the placement error the de
           "[stereo][floor][dataset]") {
   const omnislam::test::TruthDataset data =
       omnislam::test::load_truth_dataset(dataset_dir("sim-room-37-real"));
-  omnislam::stereo::ScanConfig config;
-  config.camera = data.info.camera;
-  config.camera_height_m = data.info.camera_height_m;
-  omnislam::stereo::ScanReconstructor reconstructor(config);
+  omnislam::stereo::ScanReconstructor reconstructor(scan_config_of(data));
   const omnislam::degrade::Degrader degrader({}, data.images.front().size());
   double clean = 0.0, degraded = 0.0;
   constexpr int kFrames = 6;
@@ -195,10 +199,7 @@ TEST_CASE("office-real: carpet edges short of a far wall are floor when the twin
           "[stereo][floor][dataset]") {
   const omnislam::test::TruthDataset data = omnislam::test::load_truth_dataset(dataset_dir("office-real"));
   REQUIRE(data.images.size() == 45u);
-  omnislam::stereo::ScanConfig config;
-  config.camera = data.info.camera;
-  config.camera_height_m = data.info.camera_height_m;
-  omnislam::stereo::ScanReconstructor reconstructor(config);
+  omnislam::stereo::ScanReconstructor reconstructor(scan_config_of(data));
   constexpr std::size_t kFrame = 37;
   const omnislam::test::Pose2 &pose = data.poses[kFrame - 1];
   const omnislam::stereo::LocalScan scan = reconstructor.reconstruct(data.images[kFrame - 1]);
@@ -229,10 +230,7 @@ TEST_CASE("l-room-1lap-real: range per pixel of floor contacts and of stereo poi
           "[stereo][floor][dataset]") {
   const omnislam::test::TruthDataset data =
       omnislam::test::load_truth_dataset(dataset_dir("l-room-1lap-real"));
-  omnislam::stereo::ScanConfig config;
-  config.camera = data.info.camera;
-  config.camera_height_m = data.info.camera_height_m;
-  omnislam::stereo::ScanReconstructor reconstructor(config);
+  omnislam::stereo::ScanReconstructor reconstructor(scan_config_of(data));
   std::vector<double> near_contacts, far_contacts, mid_contacts, mid_stereo;
   for (std::size_t i = 0; i < data.images.size(); i += 6) {
     for (const omnislam::stereo::ScanPoint &point : reconstructor.reconstruct(data.images[i]).points) {

@@ -417,10 +417,13 @@ TrimmedIcpResult register_trimmed_icp(const NearestNeighbors &model, const Point
   result.T_model_sample = returned.T;
   result.scale = returned.scale;
   // The fit's measures stay the plain trimmed ones (what the acceptance tests judge).
-  const std::vector<Pair> plain =
-      weighted ? trimmed_pairs(model, sample, returned, pass.search_radius_m, config, {}) : pass.pairs;
-  result.final_error_m2 = weighted ? mean_sq(plain) : pass.final_error_m2;
-  result.kept_pairs = plain.size();
+  result.final_error_m2 = pass.final_error_m2;
+  result.kept_pairs = pass.pairs.size();
+  if (weighted) {
+    const std::vector<Pair> plain = trimmed_pairs(model, sample, returned, pass.search_radius_m, config, {});
+    result.final_error_m2 = mean_sq(plain);
+    result.kept_pairs = plain.size();
+  }
   result.srel_percent = result.first_error_m2 > 0.0
                             ? 100.0 * (result.first_error_m2 - result.final_error_m2) / result.first_error_m2
                             : 0.0;

@@ -188,11 +188,13 @@ double ScanReconstructor::floor_range_per_px(float inner_row) const {
 }
 
 void ScanReconstructor::add_point(int column, double range_m, double height_m, float inner_row,
-                                  float outer_row, double range_per_px_m, LocalScan &scan) {
+                                  float outer_row, bool floor_ranged, LocalScan &scan) {
   if (range_m < config_.stereo.near_cutoff_m || range_m > config_.stereo.far_cutoff_m) {
     ++scan.stats.outside_cutoffs;
     return;
   }
+  const double range_per_px_m = floor_ranged ? floor_range_per_px(inner_row)
+                                             : stereo_range_per_px(column, inner_row, outer_row, range_m);
   const auto c = static_cast<std::size_t>(column);
   scan.points.push_back({column_azimuth_rad_[c], range_m, range_m * column_cos_[c], range_m * column_sin_[c],
                          config_.camera_height_m + height_m, inner_row, outer_row, column,
@@ -210,11 +212,8 @@ void ScanReconstructor::build_boundary_scan(LocalScan &scan) {
   scan.stats.noise_scale = boundary_stats_.noise_scale;
   scan.stats.twin_spread_px = boundary_stats_.twin_spread_px;
   for (const BoundaryPoint &point : boundary_points_) {
-    const double range_per_px_m = point.floor_ranged ? floor_range_per_px(point.inner_row)
-                                                     : stereo_range_per_px(point.column, point.inner_row,
-                                                                           point.outer_row, point.range_m);
-    add_point(point.column, point.range_m, point.height_m, point.inner_row, point.outer_row, range_per_px_m,
-              scan);
+    add_point(point.column, point.range_m, point.height_m, point.inner_row, point.outer_row,
+              point.floor_ranged, scan);
   }
   // One boundary per column already; the per-degree filter matters only for finer panoramas.
   if (config_.stereo.one_point_per_degree)
@@ -233,8 +232,7 @@ void ScanReconstructor::build_scan(const std::vector<RowMatch> &matches, LocalSc
       ++scan.stats.no_intersection;
       continue;
     }
-    add_point(match.column, point->range_m, point->height_m, match.inner_row, match.outer_row,
-              stereo_range_per_px(match.column, match.inner_row, match.outer_row, point->range_m), scan);
+    add_point(match.column, point->range_m, point->height_m, match.inner_row, match.outer_row, false, scan);
   }
   if (stereo.one_point_per_degree) scan.stats.filtered_out = keep_nearest_per_degree(scan.points, filtered_);
   scan.stats.points = static_cast<int>(scan.points.size());

@@ -75,8 +75,10 @@ class ScanReconstructor {
     return config_.stereo.boundary == BoundaryMethod::kFloorBoundary;
   }
   void build_boundary_scan(LocalScan &scan);
+  /// Adds the point unless outside the cut-offs, with its range per pixel (of the floor
+  /// plane's range when `floor_ranged`, else of the stereo range).
   void add_point(int column, double range_m, double height_m, float inner_row, float outer_row,
-                 double range_per_px_m, LocalScan &scan);
+                 bool floor_ranged, LocalScan &scan);
   /// ScanPoint::range_per_px_m of a stereo point: the range's central difference over one
   /// pixel of each row (one-sided where the other side loses the intersection), combined
   /// as independent errors; infinite when neither side of a row intersects.
