@@ -198,7 +198,7 @@ void ScanReconstructor::add_point(int column, double range_m, double height_m, f
   const auto c = static_cast<std::size_t>(column);
   scan.points.push_back({column_azimuth_rad_[c], range_m, range_m * column_cos_[c], range_m * column_sin_[c],
                          config_.camera_height_m + height_m, inner_row, outer_row, column,
-                         static_cast<float>(range_per_px_m)});
+                         static_cast<float>(range_per_px_m), floor_ranged});
 }
 
 void ScanReconstructor::build_boundary_scan(LocalScan &scan) {

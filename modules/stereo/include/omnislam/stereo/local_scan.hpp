@@ -23,6 +23,8 @@ struct ScanPoint {
   /// stereo point; infinite when half a pixel already loses the intersection. The
   /// registration weighs points by it (slam/trimmed_icp.hpp).
   float range_per_px_m = 0.0f;
+  /// Ranged from the floor plane at the inner row (a floor contact), not by stereo.
+  bool floor_ranged = false;
 };
 
 /// Counts after each step of the reconstruction, for logs, profiles and tests.
