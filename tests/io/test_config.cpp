@@ -213,6 +213,12 @@ TEST_CASE("config: the slam section, and the bundled thesis preset", "[io][confi
                     Catch::Contains("slam-bad.yaml:2") && Catch::Contains("overlap"));
   CHECK_THROWS_WITH(omnislam::io::load_config(write_file("slam-choice.yaml", "slam:\n  target: moon\n")),
                     Catch::Contains("target"));
+  CHECK(omnislam::io::Config{}.slam.icp.residual_tail_dof == 4.0);
+  CHECK(omnislam::io::load_config(write_file("slam-tail.yaml", "slam:\n  residual_tail_dof: 0\n"))
+            .slam.icp.residual_tail_dof == 0.0);
+  CHECK_THROWS_WITH(
+      omnislam::io::load_config(write_file("slam-tail-bad.yaml", "slam:\n  residual_tail_dof: -1\n")),
+      Catch::Contains("slam-tail-bad.yaml:2") && Catch::Contains("residual_tail_dof"));
   const omnislam::io::Config thesis =
       omnislam::io::load_config(OMNISLAM_SOURCE_DIR "/deploy/thesis-2008.yaml");
   CHECK(thesis.slam.use_srel_test);

@@ -255,6 +255,7 @@ void read_slam(YamlSection &section, slam::SlamConfig &slam) {
   section.read("keep_global_minimum", slam.icp.keep_global_minimum);
   section.read("covariance_sectors", slam.icp.covariance_sectors);
   section.read("range_weighting_passes", slam.icp.range_weighting_passes);
+  section.read("residual_tail_dof", slam.icp.residual_tail_dof);
   section.read("use_srel_test", slam.use_srel_test);
   section.read("srel_limit_percent", slam.srel_limit_percent);
   section.read("srel_relax_percent", slam.srel_relax_percent);
@@ -284,6 +285,8 @@ void read_slam(YamlSection &section, slam::SlamConfig &slam) {
     section.fail("covariance_sectors", "must be in 1..360");
   if (slam.icp.range_weighting_passes < 0 || slam.icp.range_weighting_passes > 10)
     section.fail("range_weighting_passes", "must be in 0..10");
+  if (!(slam.icp.residual_tail_dof >= 0.0 && std::isfinite(slam.icp.residual_tail_dof)))
+    section.fail("residual_tail_dof", "must be >= 0 (0: Gaussian residuals)");
   if (slam.icp.max_iterations < 1 || slam.icp.max_iterations > 1000) {
     section.fail("max_iterations", "must be in 1..1000");
   }

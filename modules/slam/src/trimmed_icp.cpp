@@ -23,6 +23,7 @@ struct Pair {
   Point2 sample;  ///< original (untransformed) sample point
   double residual_sq_m2;
   double weight = 1.0;   ///< relative to a point without range error (1 when unweighted)
+  double tail = 1.0;     ///< the heavy-tailed factor on the fit's weight (1 without)
   double lever_m = 0.0;  ///< b: the sample point's range per pixel along the residual
 };
 
@@ -33,10 +34,14 @@ struct Motion {
 };
 
 // How the pairs are weighted: 1 / (1 + ratio b^2), b the sample point's range per pixel
-// along the residual; ratio 0 weighs every pair alike (the plain fit).
+// along the residual; ratio 0 weighs every pair alike (the plain fit). With tail_dof nu > 0
+// the fit (not the covariance) also weighs each pair by its residual under a Student-t law
+// of scale^2 s0^2 (1 + ratio b^2) (Pair::tail).
 struct Weighting {
   std::span<const double> range_per_px_m;  ///< empty: no range errors known (b = 0)
   double ratio = 0.0;
+  double common_m2 = 0.0;  ///< s0^2 of the residual model (with the tail)
+  double tail_dof = 0.0;   ///< Student-t degrees of freedom of the residuals; 0: Gaussian
 };
 
 double residual_sq(const Point2 &moved, const Point2 &model, const Point2 &normal, IcpMetric metric) {
@@ -77,8 +82,13 @@ std::vector<Pair> trimmed_pairs(const NearestNeighbors &model, const Points2 &sa
       Pair pair{m, normal, p, residual_sq(moved, m, normal, config.metric)};
       if (with_levers) pair.lever_m = lever_m(p, motion, normal, weighting.range_per_px_m[i]);
       if (weighting.ratio > 0.0) {
-        pair.weight = 1.0 / (1.0 + weighting.ratio * pair.lever_m * pair.lever_m);
+        const double spread = 1.0 + weighting.ratio * pair.lever_m * pair.lever_m;
+        pair.weight = 1.0 / spread;
         if (!(pair.weight > 0.0)) continue;  // a range unknown to within a pixel tells nothing
+        if (weighting.tail_dof > 0.0) {
+          const double nu = weighting.tail_dof;
+          pair.tail = (nu + 1.0) / (nu + pair.residual_sq_m2 / (weighting.common_m2 * spread));
+        }
       }
       pairs.push_back(pair);
     }
@@ -129,10 +139,11 @@ NormalEquations pair_terms(const Pair &pair, const Motion &motion) {
   J << 1.0, 0.0, -moved.y(), 0.0, 1.0, moved.x();
   if (!pair.normal.isZero()) {
     const Eigen::RowVector3d row = pair.normal.transpose() * J;
-    return {pair.weight * row.transpose() * row,
-            pair.weight * row.transpose() * pair.normal.dot(moved - pair.model)};
+    const double w = pair.weight * pair.tail;
+    return {w * row.transpose() * row, w * row.transpose() * pair.normal.dot(moved - pair.model)};
   }
-  return {pair.weight * J.transpose() * J, pair.weight * J.transpose() * (moved - pair.model)};
+  const double w = pair.weight * pair.tail;
+  return {w * J.transpose() * J, w * J.transpose() * (moved - pair.model)};
 }
 
 NormalEquations normal_equations(const std::vector<Pair> &pairs, const Motion &motion) {
@@ -182,7 +193,12 @@ double mean_sq(const std::vector<Pair> &pairs) {
 // each weighted by its variance under the model (2 (s0^2 + k b^2)^2 for a Gaussian
 // residual), refitted from the plain mean. Returns k / s0^2, 0 when the residuals show no
 // range part.
-double range_noise_ratio(const std::vector<Pair> &pairs) {
+struct RangeNoise {
+  double common_m2 = 0.0;  ///< s0^2
+  double image_px2 = 0.0;  ///< k
+  [[nodiscard]] double ratio() const { return image_px2 > 0.0 ? image_px2 / common_m2 : 0.0; }
+};
+RangeNoise range_noise(const std::vector<Pair> &pairs) {
   constexpr int kRefits = 4;
   double s0_sq = std::max(mean_sq(pairs), kMinResidualVarianceM2), k = 0.0;
   for (int refit = 0; refit < kRefits; ++refit) {
@@ -196,19 +212,19 @@ double range_noise_ratio(const std::vector<Pair> &pairs) {
       A += x * x.transpose() / (variance * variance);
       y += x * pair.residual_sq_m2 / (variance * variance);
     }
-    if (std::abs(A.determinant()) <= 1e-12 * A.squaredNorm()) return 0.0;
+    if (std::abs(A.determinant()) <= 1e-12 * A.squaredNorm()) return {};
     const Eigen::Vector2d fit = A.ldlt().solve(y);
-    if (!fit.allFinite() || !(fit.y() > 0.0)) return 0.0;
+    if (!fit.allFinite() || !(fit.y() > 0.0)) return {};
     s0_sq = fit.x();
     k = fit.y();
     if (s0_sq < kMinResidualVarianceM2) {
       // The common part at its floor, the range part refitted alone.
       s0_sq = kMinResidualVarianceM2;
       k = std::max(0.0, (y.y() - A(1, 0) * s0_sq) / A(1, 1));
-      if (!(k > 0.0)) return 0.0;
+      if (!(k > 0.0)) return {};
     }
   }
-  return k / s0_sq;
+  return {s0_sq, k};
 }
 
 // Covariance of (x, y, yaw): sigma^2 (J^T J)^-1 with sigma^2 the residual variance.
@@ -401,9 +417,11 @@ TrimmedIcpResult register_trimmed_icp(const NearestNeighbors &model, const Point
   bool weighted = false;
   if (config.metric == IcpMetric::kPointToLine && !ranges.empty()) {
     for (int i = 0; i < config.range_weighting_passes; ++i) {
-      const double ratio = range_noise_ratio(pass.pairs);
+      const RangeNoise noise = range_noise(pass.pairs);
+      const double ratio = noise.ratio();
       if (!(ratio > 0.0)) break;
-      Pass next = iterate(model, sample, pass.returned, config, prior, {ranges, ratio});
+      Pass next = iterate(model, sample, pass.returned, config, prior,
+                          {ranges, ratio, noise.common_m2, config.residual_tail_dof});
       if (!next.valid) break;
       result.iterations += next.iterations;
       result.converged = next.converged;
@@ -430,10 +448,23 @@ TrimmedIcpResult register_trimmed_icp(const NearestNeighbors &model, const Point
   std::size_t inliers = 0;
   for (const Point2 &p : sample) inliers += model.nearest(returned.apply(p), kInlierDistanceM) ? 1 : 0;
   result.inlier_share = static_cast<double>(inliers) / static_cast<double>(sample.size());
-  // The covariance from the pairs as weighted: a pair's residual variance is e / weight.
-  result.covariance = covariance_of(pass.pairs, returned, pass.final_error_m2);
+  // The covariance from the pairs as weighted by their range errors: a pair's residual
+  // variance is e / weight. Without the heavy tail's factor (it reweighs residuals, it is no
+  // information), but with what the Student-t fit gains over least squares when the
+  // residuals follow that law: its covariance is sigma^2 (nu + 3) / (nu + 1) (J^T J)^-1 with
+  // sigma^2 the law's scale, e (nu - 2) / nu for e its variance (nu > 2; 0.7 e for nu 4).
+  std::vector<Pair> &pairs = pass.pairs;
+  double efficiency = 1.0;
+  for (Pair &pair : pairs) {
+    if (pair.tail != 1.0 && config.residual_tail_dof > 2.0) {
+      const double nu = config.residual_tail_dof;
+      efficiency = (nu + 3.0) * (nu - 2.0) / ((nu + 1.0) * nu);
+    }
+    pair.tail = 1.0;
+  }
+  result.covariance = covariance_of(pairs, returned, efficiency * pass.final_error_m2);
   const RobustCovariance robust =
-      robust_covariance_of(pass.pairs, returned, config.covariance_sectors, result.covariance);
+      robust_covariance_of(pairs, returned, config.covariance_sectors, result.covariance);
   result.robust_covariance = robust.covariance;
   result.covariance_dof = robust.dof;
   return result;

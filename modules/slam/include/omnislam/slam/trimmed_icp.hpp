@@ -41,6 +41,14 @@ struct TrimmedIcpConfig {
   /// s0^2 / (s0^2 + k b^2). A point ranged by stereo at 3 m moves ~8x further per pixel
   /// than a floor contact there, and far points further than near ones. 0: unweighted.
   int range_weighting_passes = 2;
+  /// Degrees of freedom nu of a Student-t law of the residuals in those passes: each pair's
+  /// weight is further multiplied by (nu + 1) / (nu + r^2 / sigma^2), r its residual and
+  /// sigma^2 = s0^2 + k b^2 its variance under the fitted model, so a pair far off that law
+  /// (a floor contact ranged from a skirting board's top, 8% long, whose small b would give
+  /// it a large weight) pulls the fit little. The covariance leaves this factor out (it
+  /// reweighs residuals, it adds no information). 4: Lange, Little & Taylor's (1989) robust
+  /// default; 0: Gaussian residuals (no factor, the behaviour before).
+  double residual_tail_dof = 4.0;
 };
 
 struct TrimmedIcpResult {
