@@ -453,15 +453,10 @@ TrimmedIcpResult register_trimmed_icp(const NearestNeighbors &model, const Point
   // information), but with what the Student-t fit gains over least squares when the
   // residuals follow that law: its covariance is sigma^2 (nu + 3) / (nu + 1) (J^T J)^-1 with
   // sigma^2 the law's scale, e (nu - 2) / nu for e its variance (nu > 2; 0.7 e for nu 4).
+  const double nu = config.residual_tail_dof;
+  const double efficiency = weighted && nu > 2.0 ? (nu + 3.0) * (nu - 2.0) / ((nu + 1.0) * nu) : 1.0;
   std::vector<Pair> &pairs = pass.pairs;
-  double efficiency = 1.0;
-  for (Pair &pair : pairs) {
-    if (pair.tail != 1.0 && config.residual_tail_dof > 2.0) {
-      const double nu = config.residual_tail_dof;
-      efficiency = (nu + 3.0) * (nu - 2.0) / ((nu + 1.0) * nu);
-    }
-    pair.tail = 1.0;
-  }
+  for (Pair &pair : pairs) pair.tail = 1.0;
   result.covariance = covariance_of(pairs, returned, efficiency * pass.final_error_m2);
   const RobustCovariance robust =
       robust_covariance_of(pairs, returned, config.covariance_sectors, result.covariance);

@@ -46,8 +46,9 @@ struct TrimmedIcpConfig {
   /// sigma^2 = s0^2 + k b^2 its variance under the fitted model, so a pair far off that law
   /// (a floor contact ranged from a skirting board's top, 8% long, whose small b would give
   /// it a large weight) pulls the fit little. The covariance leaves this factor out (it
-  /// reweighs residuals, it adds no information). 4: Lange, Little & Taylor's (1989) robust
-  /// default; 0: Gaussian residuals (no factor, the behaviour before).
+  /// reweighs residuals, it adds no information) but takes the t fit's efficiency over least
+  /// squares, (nu + 3) (nu - 2) / ((nu + 1) nu) of the residual variance (nu > 2). 4: Lange,
+  /// Little & Taylor's (1989) robust default; 0: Gaussian residuals (the behaviour before).
   double residual_tail_dof = 4.0;
 };
 
