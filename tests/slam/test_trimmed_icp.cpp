@@ -3,6 +3,8 @@
 #include <cmath>
 #include <limits>
 #include <random>
+#include <utility>
+#include <vector>
 
 #include "omnislam/slam/trimmed_icp.hpp"
 #include "synthetic_room.hpp"
@@ -192,6 +194,57 @@ TEST_CASE("trimmed ICP: the predictive covariance is the t's, dof / (dof - 2) ti
   CHECK(predictive_covariance(estimate, 1.0).isApprox(estimate * 3.0));
 }
 
+namespace {
+
+// The scan pair the range-weighting tests draw: the L-room seen from two poses (the model with
+// 2 mm of noise, up to 5 m), each sample point's range per pixel and read range given by
+// `read(i, point, noise_px, rng)` with noise_px 0.3 px of image noise drawn for it.
+struct RangedDraw {
+  Points2 model;
+  Points2 sample;
+  std::vector<double> range_per_px;
+};
+
+const Eigen::Isometry2d &ranged_model_pose() {
+  static const Eigen::Isometry2d T = pose(1.0, 1.0, 0.0);
+  return T;
+}
+const Eigen::Isometry2d &ranged_sample_pose() {
+  static const Eigen::Isometry2d T = pose(1.2, 0.9, 0.05);
+  return T;
+}
+
+template <class Read>
+RangedDraw ranged_draw(std::mt19937_64 &rng, Read read) {
+  const auto walls = omnislam::test::l_room();
+  RangedDraw draw{omnislam::test::scan_from(walls, ranged_model_pose(), rng, 0.002, 5.0),
+                  omnislam::test::scan_from(walls, ranged_sample_pose(), rng, 0.0, 5.0),
+                  {}};
+  std::normal_distribution<double> pixels(0.0, 0.3);
+  draw.range_per_px.resize(draw.sample.size());
+  for (std::size_t i = 0; i < draw.sample.size(); ++i) {
+    const double range_m = draw.sample[i].norm();
+    const double noise_px = pixels(rng);
+    const auto [range_per_px, read_m] = read(i, draw.sample[i], noise_px, rng);
+    draw.range_per_px[i] = range_per_px;
+    draw.sample[i] *= read_m / range_m;
+  }
+  return draw;
+}
+
+// The fit's position error against the true relative pose of the draw.
+double position_error_m(const omnislam::slam::TrimmedIcpResult &fit) {
+  const Eigen::Isometry2d truth = ranged_model_pose().inverse() * ranged_sample_pose();
+  return (truth.inverse() * fit.T_model_sample).translation().norm();
+}
+
+// Where every fit of these tests starts: 36 mm and 0.6 deg off the truth.
+Eigen::Isometry2d ranged_guess() {
+  return ranged_model_pose().inverse() * ranged_sample_pose() * pose(0.03, -0.02, 0.01);
+}
+
+}  // namespace
+
 TEST_CASE("trimmed ICP: points weighed by their range error per pixel outweigh the imprecise ones",
           "[slam][icp][weights]") {
   // A scan whose every second point is ranged by stereo (a short baseline: 0.25 m of range per
@@ -199,35 +252,27 @@ TEST_CASE("trimmed ICP: points weighed by their range error per pixel outweigh t
   // growing with the square of the range); 0.3 px of image noise on every point. Told each
   // point's range per pixel, the registration fits the noise model to its own residuals and
   // the imprecise half no longer pulls the pose (plain 3.4 mm, weighted 1.1 mm here).
-  const auto walls = omnislam::test::l_room();
-  const Eigen::Isometry2d T_map_model = pose(1.0, 1.0, 0.0);
-  const Eigen::Isometry2d T_map_sample = pose(1.2, 0.9, 0.05);
-  const Eigen::Isometry2d truth = T_map_model.inverse() * T_map_sample;
   double plain_error_m = 0.0, weighted_error_m = 0.0;
   constexpr int kTrials = 10;
   for (int trial = 0; trial < kTrials; ++trial) {
     std::mt19937_64 rng(100 + trial);
-    const Points2 model = omnislam::test::scan_from(walls, T_map_model, rng, 0.002, 5.0);
-    Points2 sample = omnislam::test::scan_from(walls, T_map_sample, rng, 0.0, 5.0);
-    std::normal_distribution<double> pixels(0.0, 0.3);
-    std::vector<double> range_per_px(sample.size());
-    for (std::size_t i = 0; i < sample.size(); ++i) {
-      const double range_m = sample[i].norm();
-      const bool stereo = i % 2 == 0;
-      range_per_px[i] = stereo ? 0.25 : 0.005 * range_m * range_m;
-      const double read_m = (stereo ? 0.98 * range_m : range_m) + range_per_px[i] * pixels(rng);
-      sample[i] *= read_m / range_m;
-    }
-    const Eigen::Isometry2d guess = truth * pose(0.03, -0.02, 0.01);
-    const auto plain = register_trimmed_icp(NearestNeighbors(model), sample, guess);
+    const RangedDraw draw =
+        ranged_draw(rng, [](std::size_t i, const omnislam::slam::Point2 &point, double noise_px, auto &) {
+          const double range_m = point.norm();
+          const bool stereo = i % 2 == 0;
+          const double range_per_px = stereo ? 0.25 : 0.005 * range_m * range_m;
+          return std::pair{range_per_px, (stereo ? 0.98 * range_m : range_m) + range_per_px * noise_px};
+        });
+    const NearestNeighbors model(draw.model);
+    const auto plain = register_trimmed_icp(model, draw.sample, ranged_guess());
     const auto weighted =
-        register_trimmed_icp(NearestNeighbors(model), sample, guess, {}, nullptr, range_per_px);
+        register_trimmed_icp(model, draw.sample, ranged_guess(), {}, nullptr, draw.range_per_px);
     REQUIRE(plain.valid);
     REQUIRE(weighted.valid);
     CHECK(plain.range_noise_ratio == 0.0);
     CHECK(weighted.range_noise_ratio > 0.0);
-    plain_error_m += (truth.inverse() * plain.T_model_sample).translation().norm() / kTrials;
-    weighted_error_m += (truth.inverse() * weighted.T_model_sample).translation().norm() / kTrials;
+    plain_error_m += position_error_m(plain) / kTrials;
+    weighted_error_m += position_error_m(weighted) / kTrials;
   }
   INFO("mean position error: plain " << plain_error_m << " m, weighted " << weighted_error_m << " m");
   CHECK(weighted_error_m < 0.5 * plain_error_m);
@@ -241,43 +286,36 @@ TEST_CASE("trimmed ICP: a heavy-tailed residual law keeps a run of long floor co
   // one stretch (~35 deg) the contacts are a skirting board's top: 8% long, and as precise by
   // their range per pixel as the true ones; a quarter of the other points are gross errors
   // (0.2-0.5 m short: floor texture, furniture), which the trimming takes first, so the run
-  // is kept (measured: 20.6 mm Gaussian, 11.4 mm Student-t). The range weighting alone trusts the run as much
-  // as the rest; the Student-t factor (residual_tail_dof 4) discounts it by its residuals under the fitted
-  // model.
-  const auto walls = omnislam::test::l_room();
-  const Eigen::Isometry2d T_map_model = pose(1.0, 1.0, 0.0);
-  const Eigen::Isometry2d T_map_sample = pose(1.2, 0.9, 0.05);
-  const Eigen::Isometry2d truth = T_map_model.inverse() * T_map_sample;
+  // is kept (measured: 20.6 mm Gaussian, 11.4 mm Student-t). The range weighting alone
+  // trusts the run as much as the rest; the Student-t factor (residual_tail_dof 4) discounts
+  // it by its residuals under the fitted model.
   omnislam::slam::TrimmedIcpConfig gaussian;
   gaussian.residual_tail_dof = 0.0;
   double gaussian_error_m = 0.0, tailed_error_m = 0.0;
   constexpr int kTrials = 10;
   for (int trial = 0; trial < kTrials; ++trial) {
     std::mt19937_64 rng(200 + trial);
-    const Points2 model = omnislam::test::scan_from(walls, T_map_model, rng, 0.002, 5.0);
-    Points2 sample = omnislam::test::scan_from(walls, T_map_sample, rng, 0.0, 5.0);
-    std::normal_distribution<double> pixels(0.0, 0.3);
-    std::vector<double> range_per_px(sample.size());
-    for (std::size_t i = 0; i < sample.size(); ++i) {
-      const double range_m = sample[i].norm();
-      const double bearing = std::atan2(sample[i].y(), sample[i].x());
-      const bool skirting_top = i % 2 == 1 && bearing > 0.3 && bearing < 0.9;  // ~35 deg of walls
-      const bool gross = !skirting_top && i % 4 == 1;
-      // Half of them ranged by stereo (0.25 m per pixel, as in the test above).
-      range_per_px[i] = i % 2 == 0 ? 0.25 : 0.005 * range_m * range_m;
-      double read_m = (skirting_top ? 1.08 * range_m : range_m) + range_per_px[i] * pixels(rng);
-      if (gross) read_m -= 0.2 + 0.3 * std::uniform_real_distribution<double>(0.0, 1.0)(rng);
-      sample[i] *= read_m / range_m;
-    }
-    const Eigen::Isometry2d guess = truth * pose(0.03, -0.02, 0.01);
+    const RangedDraw draw = ranged_draw(
+        rng, [](std::size_t i, const omnislam::slam::Point2 &point, double noise_px, std::mt19937_64 &draws) {
+          const double range_m = point.norm();
+          const double bearing = std::atan2(point.y(), point.x());
+          const bool skirting_top = i % 2 == 1 && bearing > 0.3 && bearing < 0.9;  // ~35 deg of walls
+          const bool gross = !skirting_top && i % 4 == 1;
+          const double range_per_px = i % 2 == 0 ? 0.25 : 0.005 * range_m * range_m;
+          double read_m = (skirting_top ? 1.08 * range_m : range_m) + range_per_px * noise_px;
+          if (gross) read_m -= 0.2 + 0.3 * std::uniform_real_distribution<double>(0.0, 1.0)(draws);
+          return std::pair{range_per_px, read_m};
+        });
+    const NearestNeighbors model(draw.model);
     const auto without =
-        register_trimmed_icp(NearestNeighbors(model), sample, guess, gaussian, nullptr, range_per_px);
-    const auto with = register_trimmed_icp(NearestNeighbors(model), sample, guess, {}, nullptr, range_per_px);
+        register_trimmed_icp(model, draw.sample, ranged_guess(), gaussian, nullptr, draw.range_per_px);
+    const auto with =
+        register_trimmed_icp(model, draw.sample, ranged_guess(), {}, nullptr, draw.range_per_px);
     REQUIRE(without.valid);
     REQUIRE(with.valid);
     REQUIRE(with.range_noise_ratio > 0.0);
-    gaussian_error_m += (truth.inverse() * without.T_model_sample).translation().norm() / kTrials;
-    tailed_error_m += (truth.inverse() * with.T_model_sample).translation().norm() / kTrials;
+    gaussian_error_m += position_error_m(without) / kTrials;
+    tailed_error_m += position_error_m(with) / kTrials;
   }
   INFO("mean position error: Gaussian " << gaussian_error_m << " m, Student-t " << tailed_error_m << " m");
   CHECK(tailed_error_m < 0.7 * gaussian_error_m);

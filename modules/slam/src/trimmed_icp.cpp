@@ -40,7 +40,7 @@ struct Motion {
 struct Weighting {
   std::span<const double> range_per_px_m;  ///< empty: no range errors known (b = 0)
   double ratio = 0.0;
-  double common_m2 = 0.0;  ///< s0^2 of the residual model (with the tail)
+  double common_m2 = 0.0;  ///< s0^2 of the residual model (the tail's scale with ratio)
   double tail_dof = 0.0;   ///< Student-t degrees of freedom of the residuals; 0: Gaussian
 };
 
@@ -137,12 +137,11 @@ NormalEquations pair_terms(const Pair &pair, const Motion &motion) {
   const Point2 moved = motion.apply(pair.sample);
   Eigen::Matrix<double, 2, 3> J;
   J << 1.0, 0.0, -moved.y(), 0.0, 1.0, moved.x();
+  const double w = pair.weight * pair.tail;
   if (!pair.normal.isZero()) {
     const Eigen::RowVector3d row = pair.normal.transpose() * J;
-    const double w = pair.weight * pair.tail;
     return {w * row.transpose() * row, w * row.transpose() * pair.normal.dot(moved - pair.model)};
   }
-  const double w = pair.weight * pair.tail;
   return {w * J.transpose() * J, w * J.transpose() * (moved - pair.model)};
 }
 
@@ -455,11 +454,10 @@ TrimmedIcpResult register_trimmed_icp(const NearestNeighbors &model, const Point
   // sigma^2 the law's scale, e (nu - 2) / nu for e its variance (nu > 2; 0.7 e for nu 4).
   const double nu = config.residual_tail_dof;
   const double efficiency = weighted && nu > 2.0 ? (nu + 3.0) * (nu - 2.0) / ((nu + 1.0) * nu) : 1.0;
-  std::vector<Pair> &pairs = pass.pairs;
-  for (Pair &pair : pairs) pair.tail = 1.0;
-  result.covariance = covariance_of(pairs, returned, efficiency * pass.final_error_m2);
+  for (Pair &pair : pass.pairs) pair.tail = 1.0;
+  result.covariance = covariance_of(pass.pairs, returned, efficiency * pass.final_error_m2);
   const RobustCovariance robust =
-      robust_covariance_of(pairs, returned, config.covariance_sectors, result.covariance);
+      robust_covariance_of(pass.pairs, returned, config.covariance_sectors, result.covariance);
   result.robust_covariance = robust.covariance;
   result.covariance_dof = robust.dof;
   return result;
