@@ -164,7 +164,7 @@ void KeyframeGraph::add_pose(const Eigen::Isometry2d &T_map_base) {
 }
 
 bool KeyframeGraph::add_integrated(const Points2 &scan_base, const Eigen::Isometry2d &T_map_base,
-                                   const Eigen::Matrix3d &registration_covariance) {
+                                   const Eigen::Matrix3d &tracked_covariance) {
   if (!keyframes_.empty()) path_m_ += (T_map_base.translation() - last_frame_.translation()).norm();
   last_frame_ = T_map_base;
   // After a resume that does not continue the saved tracking, the first integrated frame
@@ -179,14 +179,13 @@ bool KeyframeGraph::add_integrated(const Points2 &scan_base, const Eigen::Isomet
     const int node = graph_.add_node(T_map_base);
     if (node > 0 && chained_) {
       // The sequential edge: the relative pose the tracking produced, with the
-      // registration's covariance plus the drift the tracking can accumulate over it.
+      // tracking's covariance over it plus the floor.
       const Keyframe &previous = keyframes_.back();
       const Eigen::Isometry2d T_previous_current = previous.T_map_keyframe.inverse() * T_map_base;
-      const double travelled_m = path_m_ - previous.path_m;
-      const double sigma_xy = config_.edge_floor_xy_m + config_.drift_per_m * travelled_m;
-      const double sigma_yaw = config_.edge_floor_yaw_rad + config_.drift_yaw_per_m * travelled_m;
+      const double sigma_xy = config_.edge_floor_xy_m;
+      const double sigma_yaw = config_.edge_floor_yaw_rad;
       const Eigen::Matrix3d covariance =
-          rotated_covariance(registration_covariance, previous.T_map_keyframe.linear().transpose()) +
+          rotated_covariance(tracked_covariance, previous.T_map_keyframe.linear().transpose()) +
           Eigen::Vector3d(sigma_xy * sigma_xy, sigma_xy * sigma_xy, sigma_yaw * sigma_yaw)
               .asDiagonal()
               .toDenseMatrix();

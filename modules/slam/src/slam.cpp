@@ -66,9 +66,7 @@ Eigen::Matrix3d Slam::published_covariance(const FrameEstimate &estimate, const 
     return predictive_covariance(walk_covariance_, walk_dof_);
   }
   const Eigen::Matrix3d before = carried(walk_covariance_, previous_.T_map_base, estimate.T_map_base);
-  const Eigen::Matrix3d term =
-      estimate.integrated ? registration.robust_covariance
-                          : rotated_covariance(odometry_step_covariance(step), previous_.T_map_base.linear());
+  const Eigen::Matrix3d term = frame_term(estimate, step);
   const double term_dof =
       estimate.integrated ? registration.covariance_dof : std::numeric_limits<double>::infinity();
   const double shares = satterthwaite_share(before, walk_dof_) + satterthwaite_share(term, term_dof);
@@ -76,6 +74,12 @@ Eigen::Matrix3d Slam::published_covariance(const FrameEstimate &estimate, const 
   const double size = position_size(walk_covariance_);
   walk_dof_ = shares > 0.0 ? size * size / shares : std::numeric_limits<double>::infinity();
   return predictive_covariance(walk_covariance_, walk_dof_);
+}
+
+Eigen::Matrix3d Slam::frame_term(const FrameEstimate &estimate, const Eigen::Isometry2d &step) const {
+  return estimate.integrated
+             ? estimate.registration.robust_covariance
+             : rotated_covariance(odometry_step_covariance(step), previous_.T_map_base.linear());
 }
 
 bool Slam::accept(const TrimmedIcpResult &registration, const Eigen::Isometry2d &predicted,
@@ -195,6 +199,7 @@ void Slam::resume(std::vector<MapPoint> points, int integrations, const Eigen::I
   previous_ = {T_map_base, true, Attempt::kNone, {}, covariance};
   walk_covariance_ = covariance;
   walk_dof_ = std::numeric_limits<double>::infinity();
+  since_keyframe_covariance_.setZero();  // the saved pose is taken as is
   // Until a scan has been seen, the whole map stands in for the previous local map.
   recent_scans_map_.assign(1, map_.index().points());
   relaxation_percent_ = 0.0;
@@ -228,7 +233,8 @@ void Slam::set_pose(const Eigen::Isometry2d &T_map_base, const Eigen::Matrix3d &
   previous_.covariance = covariance;
   walk_covariance_ = covariance;
   walk_dof_ = std::numeric_limits<double>::infinity();
-  uncommitted_covariance_ = covariance;  // the operator's pose is as rough as they say
+  uncommitted_covariance_ = covariance;     // the operator's pose is as rough as they say
+  since_keyframe_covariance_ = covariance;  // so is its relation to the last keyframe
   last_step_ = Eigen::Isometry2d::Identity();
   // The scans before the jump sit at the old poses: the whole map stands in for them.
   if (!map_.empty()) recent_scans_map_.assign(1, map_.index().points());
@@ -257,9 +263,9 @@ FrameEstimate Slam::seed_map(const Points2 &scan_base) {
 }
 
 Eigen::Isometry2d Slam::update_graph(const Points2 &scan_base, FrameEstimate &estimate) {
-  estimate.keyframe =
-      keyframes_.add_integrated(scan_base, estimate.T_map_base, estimate.registration.covariance);
+  estimate.keyframe = keyframes_.add_integrated(scan_base, estimate.T_map_base, since_keyframe_covariance_);
   if (!estimate.keyframe) return estimate.T_map_base;
+  since_keyframe_covariance_.setZero();
   search_due_ = true;
   if (config_.loop_closure.background) return estimate.T_map_base;  // the caller runs the job
   search_due_ = false;
@@ -387,6 +393,11 @@ FrameEstimate Slam::process(const Points2 &scan_base, const std::optional<Eigen:
 
   bool in_graph = false;  // recorded as an integrated frame of the keyframe graph
   uncommitted_covariance_ = estimate.integrated ? Eigen::Matrix3d::Zero() : prediction_covariance_;
+  // The tracking's uncertainty of this pose relative to the last keyframe: the same terms
+  // as the published walk's, summed from that keyframe on (the next sequential edge's).
+  since_keyframe_covariance_ =
+      carried(since_keyframe_covariance_, previous_.T_map_base, estimate.T_map_base) +
+      frame_term(estimate, step);
   if (estimate.integrated) {
     relaxation_percent_ = 0.0;
     // A frame without odometry is registered but never changes the map: along a corridor

@@ -26,12 +26,16 @@ namespace omnislam::slam {
 struct KeyframeConfig {
   double keyframe_distance_m = 0.5;    ///< travel that makes the next integrated frame a keyframe
   double keyframe_angle_rad = 0.3491;  ///< or turn (20 deg)
-  /// Standard deviation of a sequential edge: a floor (so an exact or degenerate fit never
-  /// gives infinite confidence) plus drift_per_m per metre between the two keyframes.
+  /// A sequential edge's covariance is the tracking's own between its two keyframes (the
+  /// published walk's terms summed over the frames in between: along a plain corridor the
+  /// odometry's, across it the registrations') plus this floor, standard deviations, for
+  /// what no frame's estimate sees (the front-end's systematic errors, an exact fit).
   double edge_floor_xy_m = 0.01;
   double edge_floor_yaw_rad = 0.0087;  ///< 0.5 deg
-  double drift_per_m = 0.03;           ///< position drift of scan-to-map tracking, m per m travelled
-  double drift_yaw_per_m = 0.0087;     ///< heading drift, rad per m travelled (0.5 deg/m)
+  /// A priori drift of scan-to-map tracking per metre travelled, on top of the floor: the
+  /// loop search's window (LoopClosureConfig), not the edges.
+  double drift_per_m = 0.03;        ///< position, m per m travelled
+  double drift_yaw_per_m = 0.0087;  ///< heading, rad per m travelled (0.5 deg/m)
 };
 
 struct Keyframe {
@@ -103,11 +107,11 @@ class KeyframeGraph {
   [[nodiscard]] KeyframeGraphState state() const;
 
   /// Records an integrated frame at `T_map_base` with its scan (base_link); it becomes a
-  /// keyframe (joined to the previous one by a sequential edge whose covariance is the
-  /// registration's plus the drift floor) when far enough from the last one. Returns
-  /// whether it did.
+  /// keyframe when far enough from the last one, joined to it by a sequential edge whose
+  /// covariance is `tracked_covariance` (map frame: the tracking's uncertainty of this pose
+  /// relative to the last keyframe) plus the floor. Returns whether it did.
   bool add_integrated(const Points2 &scan_base, const Eigen::Isometry2d &T_map_base,
-                      const Eigen::Matrix3d &registration_covariance);
+                      const Eigen::Matrix3d &tracked_covariance);
   /// Records a frame that was not integrated (only its pose, relative to the last keyframe).
   void add_pose(const Eigen::Isometry2d &T_map_base);
 

@@ -189,6 +189,10 @@ class Slam {
   /// advances the random walk it is made of (walk_covariance_) to this frame.
   [[nodiscard]] Eigen::Matrix3d published_covariance(const FrameEstimate &estimate,
                                                      const Eigen::Isometry2d &step);
+  /// What `estimate` adds to the uncertainty of the tracking: its registration's
+  /// cluster-robust covariance, or the odometry step's when it was not integrated.
+  [[nodiscard]] Eigen::Matrix3d frame_term(const FrameEstimate &estimate,
+                                           const Eigen::Isometry2d &step) const;
   [[nodiscard]] FrameEstimate register_scan(const Points2 &scan_base, const Eigen::Isometry2d &predicted,
                                             std::span<const double> range_per_px_m);
   /// How far beyond a scan at its predicted pose the map must be indexed for a registration
@@ -246,6 +250,9 @@ class Slam {
   /// a model: odometry, an operator's or a saved pose).
   Eigen::Matrix3d walk_covariance_ = Eigen::Matrix3d::Zero();
   double walk_dof_ = std::numeric_limits<double>::infinity();
+  /// The walk's terms since the last keyframe (map frame): the tracking's uncertainty of
+  /// the current pose relative to that keyframe, the next sequential edge's covariance.
+  Eigen::Matrix3d since_keyframe_covariance_ = Eigen::Matrix3d::Zero();
   bool predicted_by_odometry_ = false;  ///< the current frame's prediction came from odometry
   bool previous_failed_ = false;
 };
