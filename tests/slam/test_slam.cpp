@@ -180,6 +180,60 @@ TEST_CASE("SLAM: the published covariance carries the previous pose's and adds e
   CHECK(blind.covariance(0, 0) > previous(0, 0));
 }
 
+TEST_CASE("SLAM: a sequential edge carries the tracking's covariance between its keyframes",
+          "[slam][covariance]") {
+  // The relative pose of two consecutive keyframes is as uncertain as the tracking made it:
+  // the published walk's terms (each registration's robust covariance) summed over the frames
+  // after the first keyframe up to the second, each sum carried by the lever arm of the
+  // motion, in the first keyframe's frame, plus the floor. Along a plain corridor that is the
+  // odometry prior's share, across it and in heading the registrations', so a loop closure
+  // stretches the corridor instead of turning the loop.
+  SlamConfig config;
+  config.loop_closure.keyframes.keyframe_distance_m = 0.35;
+  Slam slam(config);
+  const auto walls = omnislam::test::l_room();
+  std::mt19937_64 rng(4);
+  Eigen::Matrix3d since = Eigen::Matrix3d::Zero();
+  Eigen::Isometry2d previous_pose = Eigen::Isometry2d::Identity();
+  Eigen::Isometry2d keyframe_pose = Eigen::Isometry2d::Identity();
+  int edges_checked = 0;
+  for (int i = 0; i < 12; ++i) {
+    const Eigen::Isometry2d truth = pose(0.1 * i, 0.01 * i, 0.02 * i);
+    const auto estimate = slam.process(omnislam::test::scan_from(walls, truth, rng), truth);
+    if (i == 0) {
+      REQUIRE(estimate.keyframe);
+      previous_pose = keyframe_pose = estimate.T_map_base;
+      continue;
+    }
+    REQUIRE(estimate.integrated);
+    const Eigen::Vector2d lever = estimate.T_map_base.translation() - previous_pose.translation();
+    Eigen::Matrix3d F = Eigen::Matrix3d::Identity();
+    F(0, 2) = -lever.y();
+    F(1, 2) = lever.x();
+    since = F * since * F.transpose() + estimate.registration.robust_covariance;
+    previous_pose = estimate.T_map_base;
+    if (!estimate.keyframe) continue;
+    const omnislam::slam::KeyframeConfig &floor = config.loop_closure.keyframes;
+    Eigen::Matrix3d R = Eigen::Matrix3d::Identity();
+    R.topLeftCorner<2, 2>() = keyframe_pose.linear().transpose();
+    const Eigen::Matrix3d expected =
+        R * since * R.transpose() + Eigen::Vector3d(floor.edge_floor_xy_m * floor.edge_floor_xy_m,
+                                                    floor.edge_floor_xy_m * floor.edge_floor_xy_m,
+                                                    floor.edge_floor_yaw_rad * floor.edge_floor_yaw_rad)
+                                        .asDiagonal()
+                                        .toDenseMatrix();
+    const auto &edges = slam.keyframes().graph().edges();
+    REQUIRE(edges.size() == static_cast<std::size_t>(edges_checked + 1));
+    const Eigen::Matrix3d edge_covariance = edges.back().information.inverse();
+    INFO("edge " << edges_checked << "\n" << edge_covariance << "\nexpected\n" << expected);
+    CHECK(edge_covariance.isApprox(expected, 1e-6));
+    ++edges_checked;
+    since.setZero();
+    keyframe_pose = estimate.T_map_base;
+  }
+  CHECK(edges_checked >= 2);
+}
+
 TEST_CASE("SLAM: frames without odometry extrapolate the last motion and keep the pose a rotation",
           "[slam]") {
   // The extrapolated step is the last pose's inverse times this one's; Isometry2d::inverse()
