@@ -68,6 +68,17 @@ RunErrors run(const SlamConfig &config, std::uint64_t seed, const std::vector<Ei
   return errors;
 }
 
+// A pose covariance carried from `from` to `to` by a motion taken as exact: the heading's
+// error swings the position by the lever arm between the two poses.
+Eigen::Matrix3d carried_by_motion(const Eigen::Matrix3d &covariance, const Eigen::Isometry2d &from,
+                                  const Eigen::Isometry2d &to) {
+  const Eigen::Vector2d lever = to.translation() - from.translation();
+  Eigen::Matrix3d F = Eigen::Matrix3d::Identity();
+  F(0, 2) = -lever.y();
+  F(1, 2) = lever.x();
+  return F * covariance * F.transpose();
+}
+
 }  // namespace
 
 TEST_CASE("SLAM with noisy odometry beats odometry on a synthetic L-room lap", "[slam]") {
@@ -147,11 +158,7 @@ TEST_CASE("SLAM: the published covariance carries the previous pose's and adds e
     const auto estimate = slam.process(omnislam::test::scan_from(walls, truth, rng), truth);
     if (i > 0) {
       REQUIRE(estimate.integrated);
-      const Eigen::Vector2d lever = estimate.T_map_base.translation() - previous_pose.translation();
-      Eigen::Matrix3d F = Eigen::Matrix3d::Identity();
-      F(0, 2) = -lever.y();
-      F(1, 2) = lever.x();
-      const Eigen::Matrix3d carried = F * walk * F.transpose();
+      const Eigen::Matrix3d carried = carried_by_motion(walk, previous_pose, estimate.T_map_base);
       const double carried_size = carried.topLeftCorner<2, 2>().trace();
       const double walk_size = walk.topLeftCorner<2, 2>().trace();
       // Carrying rescales the walk's earlier terms alike: its degrees of freedom stay.
@@ -206,22 +213,18 @@ TEST_CASE("SLAM: a sequential edge carries the tracking's covariance between its
       continue;
     }
     REQUIRE(estimate.integrated);
-    const Eigen::Vector2d lever = estimate.T_map_base.translation() - previous_pose.translation();
-    Eigen::Matrix3d F = Eigen::Matrix3d::Identity();
-    F(0, 2) = -lever.y();
-    F(1, 2) = lever.x();
-    since = F * since * F.transpose() + estimate.registration.robust_covariance;
+    since = carried_by_motion(since, previous_pose, estimate.T_map_base) +
+            estimate.registration.robust_covariance;
     previous_pose = estimate.T_map_base;
     if (!estimate.keyframe) continue;
     const omnislam::slam::KeyframeConfig &floor = config.loop_closure.keyframes;
-    Eigen::Matrix3d R = Eigen::Matrix3d::Identity();
-    R.topLeftCorner<2, 2>() = keyframe_pose.linear().transpose();
     const Eigen::Matrix3d expected =
-        R * since * R.transpose() + Eigen::Vector3d(floor.edge_floor_xy_m * floor.edge_floor_xy_m,
-                                                    floor.edge_floor_xy_m * floor.edge_floor_xy_m,
-                                                    floor.edge_floor_yaw_rad * floor.edge_floor_yaw_rad)
-                                        .asDiagonal()
-                                        .toDenseMatrix();
+        omnislam::slam::rotated_covariance(since, keyframe_pose.linear().transpose()) +
+        Eigen::Vector3d(floor.edge_floor_xy_m * floor.edge_floor_xy_m,
+                        floor.edge_floor_xy_m * floor.edge_floor_xy_m,
+                        floor.edge_floor_yaw_rad * floor.edge_floor_yaw_rad)
+            .asDiagonal()
+            .toDenseMatrix();
     const auto &edges = slam.keyframes().graph().edges();
     REQUIRE(edges.size() == static_cast<std::size_t>(edges_checked + 1));
     const Eigen::Matrix3d edge_covariance = edges.back().information.inverse();

@@ -182,13 +182,11 @@ bool KeyframeGraph::add_integrated(const Points2 &scan_base, const Eigen::Isomet
       // tracking's covariance over it plus the floor.
       const Keyframe &previous = keyframes_.back();
       const Eigen::Isometry2d T_previous_current = previous.T_map_keyframe.inverse() * T_map_base;
-      const double sigma_xy = config_.edge_floor_xy_m;
-      const double sigma_yaw = config_.edge_floor_yaw_rad;
+      const Eigen::Vector3d floor(config_.edge_floor_xy_m, config_.edge_floor_xy_m,
+                                  config_.edge_floor_yaw_rad);
       const Eigen::Matrix3d covariance =
           rotated_covariance(tracked_covariance, previous.T_map_keyframe.linear().transpose()) +
-          Eigen::Vector3d(sigma_xy * sigma_xy, sigma_xy * sigma_xy, sigma_yaw * sigma_yaw)
-              .asDiagonal()
-              .toDenseMatrix();
+          Eigen::Matrix3d(floor.cwiseAbs2().asDiagonal());
       graph_.add_edge({node - 1, node, T_previous_current, covariance.inverse(), false});
     }
     keyframes_.push_back({T_map_base, path_m_, {}});

@@ -43,7 +43,7 @@ double satterthwaite_share(const Eigen::Matrix3d &term, double dof) {
 
 }  // namespace
 
-Eigen::Matrix3d Slam::published_covariance(const FrameEstimate &estimate, const Eigen::Isometry2d &step) {
+Eigen::Matrix3d Slam::published_covariance(const FrameEstimate &estimate, const Eigen::Matrix3d &term) {
   // What the pose's error against the map frame is made of. On a fixed map (localization
   // only) the registration's alone. Otherwise the map the frame registered against was
   // built from the poses before it, whose errors it inherits: the previous pose's covariance
@@ -66,7 +66,6 @@ Eigen::Matrix3d Slam::published_covariance(const FrameEstimate &estimate, const 
     return predictive_covariance(walk_covariance_, walk_dof_);
   }
   const Eigen::Matrix3d before = carried(walk_covariance_, previous_.T_map_base, estimate.T_map_base);
-  const Eigen::Matrix3d term = frame_term(estimate, step);
   const double term_dof =
       estimate.integrated ? registration.covariance_dof : std::numeric_limits<double>::infinity();
   const double shares = satterthwaite_share(before, walk_dof_) + satterthwaite_share(term, term_dof);
@@ -395,9 +394,9 @@ FrameEstimate Slam::process(const Points2 &scan_base, const std::optional<Eigen:
   uncommitted_covariance_ = estimate.integrated ? Eigen::Matrix3d::Zero() : prediction_covariance_;
   // The tracking's uncertainty of this pose relative to the last keyframe: the same terms
   // as the published walk's, summed from that keyframe on (the next sequential edge's).
+  const Eigen::Matrix3d term = frame_term(estimate, step);
   since_keyframe_covariance_ =
-      carried(since_keyframe_covariance_, previous_.T_map_base, estimate.T_map_base) +
-      frame_term(estimate, step);
+      carried(since_keyframe_covariance_, previous_.T_map_base, estimate.T_map_base) + term;
   if (estimate.integrated) {
     relaxation_percent_ = 0.0;
     // A frame without odometry is registered but never changes the map: along a corridor
@@ -413,7 +412,7 @@ FrameEstimate Slam::process(const Points2 &scan_base, const std::optional<Eigen:
   } else {
     relaxation_percent_ += config_.srel_relax_percent;
   }
-  estimate.covariance = published_covariance(estimate, step);
+  estimate.covariance = published_covariance(estimate, term);
   if (!in_graph) keyframes_.add_pose(estimate.T_map_base);
   estimate.trajectory_index = keyframes_.frame_count() - 1;
   // A background job's result applied before this frame.

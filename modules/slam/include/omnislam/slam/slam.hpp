@@ -185,10 +185,10 @@ class Slam {
  private:
   [[nodiscard]] bool accept(const TrimmedIcpResult &registration, const Eigen::Isometry2d &predicted,
                             const Eigen::Isometry2d &estimate, double srel_limit_percent) const;
-  /// The covariance published with `estimate`, `step` the odometry motion it was predicted by;
+  /// The covariance published with `estimate`, `term` what the frame adds (frame_term);
   /// advances the random walk it is made of (walk_covariance_) to this frame.
   [[nodiscard]] Eigen::Matrix3d published_covariance(const FrameEstimate &estimate,
-                                                     const Eigen::Isometry2d &step);
+                                                     const Eigen::Matrix3d &term);
   /// What `estimate` adds to the uncertainty of the tracking: its registration's
   /// cluster-robust covariance, or the odometry step's when it was not integrated.
   [[nodiscard]] Eigen::Matrix3d frame_term(const FrameEstimate &estimate,
