@@ -44,7 +44,8 @@ TEST_CASE("config: every section read on top of the defaults", "[io][config]") {
                                    "    max_edges_per_column: 20\n"
                                    "    contact_margin_px: 2.0\n"
                                    "    error_rate: 0.05\n"
-                                   "    floor_plane_range: false\n");
+                                   "    floor_plane_range: false\n"
+                                   "    contact_ray_sigma_px: 1.0\n");
   const omnislam::io::Config config = omnislam::io::load_config(file);
   const auto &scan = config.scan;
   CHECK(scan.camera.image_width_px == 800);
@@ -68,6 +69,7 @@ TEST_CASE("config: every section read on top of the defaults", "[io][config]") {
   CHECK(scan.stereo.floor.contact_margin_px == 2.0);
   CHECK(scan.stereo.floor.error_rate == 0.05);
   CHECK_FALSE(scan.stereo.floor.floor_plane_range);
+  CHECK(scan.stereo.floor.contact_ray_sigma_px == 1.0);
   CHECK(scan.stereo.near_cutoff_m == 0.3);
 }
 

@@ -1,4 +1,6 @@
+#include <algorithm>
 #include <catch2/catch.hpp>
+#include <cmath>
 #include <cstdint>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
@@ -8,6 +10,7 @@
 #include "omnislam/vision/edge_detector.hpp"
 #include "omnislam/vision/edge_selection.hpp"
 #include "omnislam/vision/panorama_unwarper.hpp"
+#include "omnislam/vision/ray_subpixel.hpp"
 #include "omnislam/vision/texture.hpp"
 
 using omnislam::mirror::Lobe;
@@ -24,6 +27,24 @@ cv::Mat step_panorama(double boundary_row) {
   for (int row = 0; row < pano.rows; ++row) {
     const double light = std::clamp(boundary_row - row + 0.5, 0.0, 1.0);  // area coverage
     pano.row(row).setTo(static_cast<int>(std::lround(90 + 110 * light)));
+  }
+  return pano;
+}
+
+// A steep step, as a wall seen obliquely makes it: in column c the floor (light, below) meets
+// a darker band (above) at row boundary(c) = 120 + 2.5 (c - 180), and the step's contrast
+// falls off along it (the light at the wall's base fading with distance), so each column's
+// neighbours on one side have the stronger edge. Pixels are area-averaged along the column.
+double steep_boundary(int column) { return 120.0 + 2.5 * (column - 180); }
+cv::Mat steep_step_panorama() {
+  cv::Mat pano(225, 360, CV_8UC1, cv::Scalar(60));
+  for (int column = 150; column < 211; ++column) {
+    const double contrast = 140.0 * std::exp(-(column - 150) / 12.0) + 20.0;
+    for (int row = 0; row < pano.rows; ++row) {
+      const double floor_share = std::clamp(row + 0.5 - steep_boundary(column), 0.0, 1.0);
+      pano.at<std::uint8_t>(row, column) =
+          static_cast<std::uint8_t>(std::lround(60.0 + contrast * floor_share));
+    }
   }
   return pano;
 }
@@ -171,4 +192,37 @@ TEST_CASE("Blackman kernel: 7 taps, symmetric, normalised", "[vision][texture]")
   make_texture(flat, kernel, texture);
   CHECK(texture.type() == CV_32FC1);
   CHECK(texture.at<float>(100, 100) == Approx(1.0f));
+}
+
+TEST_CASE(
+    "an edge's row along its ray: a steep edge whose contrast changes along it is found where it crosses",
+    "[vision][selection]") {
+  const cv::Mat pano = steep_step_panorama();
+  EdgeImage edges;
+  EdgeDetector().detect(pano, edges);
+  cv::Mat texture;
+  make_texture(pano, {}, texture);
+  EdgeSelectionConfig config;
+  config.min_relative_contrast = 0.0;
+  ColumnEdges candidates;
+  select_nearest_horizontal_edges(edges, texture, config, candidates);
+  double canny_error = 0.0, ray_error = 0.0;
+  int found = 0;
+  for (int column = 160; column <= 200; ++column) {
+    const double truth = steep_boundary(column);
+    for (const EdgePoint &edge : candidates.column(column)) {
+      if (std::abs(edge.row - truth) > 2.0) continue;
+      const float ray = ray_subpixel_row(texture, edges, edge, column, 1.0);
+      CHECK(ray == Approx(truth).margin(0.1));
+      CHECK(ray_subpixel_row(texture, edges, edge, column, 0.0) ==
+            edge.row_subpx);  // off: the edge's own row
+      canny_error += std::abs(edge.row_subpx - truth);
+      ray_error += std::abs(ray - truth);
+      ++found;
+    }
+  }
+  REQUIRE(found >= 30);
+  // Canny's gradient mixes the neighbouring columns' rows, weighted by their contrast.
+  CHECK(canny_error / found > 0.15);
+  CHECK(ray_error / found < 0.05);
 }

@@ -156,12 +156,15 @@ void read_stereo(YamlSection &section, stereo::StereoConfig &stereo) {
     floor.read("contact_margin_px", config.contact_margin_px);
     floor.read("error_rate", config.error_rate);
     floor.read("floor_plane_range", config.floor_plane_range);
+    floor.read("contact_ray_sigma_px", config.contact_ray_sigma_px);
     if (config.max_edges_per_column < 1 || config.max_edges_per_column > 64)
       floor.fail("max_edges_per_column", "must be 1..64");
     if (!(config.contact_margin_px > 0.0 && config.contact_margin_px <= 10.0))
       floor.fail("contact_margin_px", "must be in (0, 10]");
     if (!(config.error_rate > 0.0 && config.error_rate < 0.5))
       floor.fail("error_rate", "must be in (0, 0.5)");
+    if (!(config.contact_ray_sigma_px >= 0.0 && config.contact_ray_sigma_px <= 5.0))
+      floor.fail("contact_ray_sigma_px", "must be in [0, 5]");
   });
 
   if (!(stereo.max_range_m > stereo.min_range_m)) section.fail("max_range_m", "must exceed min_range_m");

@@ -8,6 +8,8 @@
 #include <numbers>
 #include <opencv2/imgproc.hpp>
 
+#include "omnislam/vision/ray_subpixel.hpp"
+
 namespace omnislam::stereo {
 namespace {
 
@@ -546,9 +548,11 @@ BoundaryStats FloorBoundaryFinder::find(const FloorGeometry &geometry, const cv:
       }
       ++stats.floor_contacts;
       if (verdict == Verdict::kUndecided) ++stats.undecided;
-      const auto range_m = static_cast<float>(geometry_->floor_range_at(base->row_subpx));
-      BoundaryPoint point{column,  base->row_subpx, outer_row,
-                          range_m, floor_height_m,  config_.floor_plane_range};
+      // Its range from the row where the contact crosses this column's ray.
+      const float contact_row =
+          vision::ray_subpixel_row(inner_texture, inner_edges, *base, column, config_.contact_ray_sigma_px);
+      const auto range_m = static_cast<float>(geometry_->floor_range_at(contact_row));
+      BoundaryPoint point{column, contact_row, outer_row, range_m, floor_height_m, config_.floor_plane_range};
       if (!config_.floor_plane_range) {
         const auto stereo = triangulator.triangulate(column, base->row_subpx, outer_row);
         if (!stereo) continue;

@@ -44,6 +44,13 @@ struct FloorBoundaryConfig {
   double error_rate = 0.01;
   /// Range of a floor contact: from the floor plane (true) or from the stereo pair.
   bool floor_plane_range = true;
+  /// When > 0, a floor contact's row for its floor-plane range is measured along the
+  /// mirror's rays (vision/ray_subpixel.hpp), its column smoothed along itself with a
+  /// Gaussian of this sigma (px), not across columns as the edge search's rows are. It
+  /// removes the bend of walls seen obliquely on the realistic rooms, but off by default:
+  /// the runs' figures move both ways (README "Front-end on real floors", 2026-12-04).
+  /// 0: the edge's own sub-pixel row.
+  double contact_ray_sigma_px = 0.0;
 };
 
 struct StereoConfig {

@@ -1,0 +1,99 @@
+#include "omnislam/vision/ray_subpixel.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <optional>
+#include <vector>
+
+namespace omnislam::vision {
+namespace {
+
+// Vertex of the parabola through (-1, a), (0, b), (1, c), clamped to half a pixel.
+float parabola_vertex(float a, float b, float c) {
+  const float curvature = a - 2.0f * b + c;
+  if (!(curvature < 0.0f)) return 0.0f;
+  return std::clamp(0.5f * (a - c) / curvature, -0.5f, 0.5f);
+}
+
+// One column's profile about `row`: the texture smoothed along the column by `taps`, S,
+// and its central differences S(r + 1) - S(r - 1) at rows row - 2 .. row + 2.
+class RayProfile {
+ public:
+  RayProfile(const cv::Mat &texture, int row, int column, const std::vector<float> &taps) : row_(row) {
+    const int half = static_cast<int>(taps.size() / 2);
+    const int last = texture.rows - 1;
+    std::array<float, 7> smoothed{};
+    for (int i = 0; i < 7; ++i) {
+      float sum = 0.0f;
+      for (int t = -half; t <= half; ++t)
+        sum += taps[static_cast<std::size_t>(t + half)] *
+               texture.at<float>(std::clamp(row - 3 + i + t, 0, last), column);
+      smoothed[static_cast<std::size_t>(i)] = sum;
+    }
+    for (int i = 0; i < 5; ++i)
+      difference_[static_cast<std::size_t>(i)] =
+          smoothed[static_cast<std::size_t>(i + 2)] - smoothed[static_cast<std::size_t>(i)];
+  }
+
+  [[nodiscard]] float polarity() const { return difference_[2] >= 0.0f ? 1.0f : -1.0f; }
+
+  // The peak of the gradient of polarity `sign` among row - 1 .. row + 1, refined by a
+  // parabola; empty when none of those rows is a local maximum of it.
+  [[nodiscard]] std::optional<float> peak(float sign) const {
+    std::array<float, 5> g{};
+    for (std::size_t i = 0; i < 5; ++i) g[i] = std::max(0.0f, sign * difference_[i]);
+    std::size_t best = 2;
+    if (g[1] > g[best]) best = 1;
+    if (g[3] > g[best]) best = 3;
+    if (!(g[best] > 0.0f) || g[best - 1] > g[best] || g[best + 1] > g[best]) return std::nullopt;
+    return static_cast<float>(row_ + static_cast<int>(best) - 2) +
+           parabola_vertex(g[best - 1], g[best], g[best + 1]);
+  }
+
+ private:
+  int row_;
+  std::array<float, 5> difference_{};
+};
+
+std::vector<float> gaussian_taps(double sigma_px) {
+  const int half = static_cast<int>(std::ceil(3.0 * sigma_px));
+  std::vector<float> taps(static_cast<std::size_t>(2 * half + 1));
+  double sum = 0.0;
+  for (int i = -half; i <= half; ++i) sum += std::exp(-0.5 * i * i / (sigma_px * sigma_px));
+  for (int i = -half; i <= half; ++i)
+    taps[static_cast<std::size_t>(i + half)] =
+        static_cast<float>(std::exp(-0.5 * i * i / (sigma_px * sigma_px)) / sum);
+  return taps;
+}
+
+}  // namespace
+
+float ray_subpixel_row(const cv::Mat &texture, const EdgeImage &edges, const EdgePoint &edge, int column,
+                       double sigma_px) {
+  if (!(sigma_px > 0.0)) return edge.row_subpx;
+  const std::vector<float> taps = gaussian_taps(sigma_px);
+  const RayProfile own_profile(texture, edge.row, column, taps);
+  const float sign = own_profile.polarity();
+  const std::optional<float> own = own_profile.peak(sign);
+  if (!own) return edge.row_subpx;
+  // Rows per column along the edge: its tangent is across Canny's gradient.
+  const float along = edges.grad_row.at<std::int16_t>(edge.row, column);
+  const float across = edges.grad_col.at<std::int16_t>(edge.row, column);
+  const float slope = along != 0.0f ? -across / along : 0.0f;
+  float sum = *own;
+  for (const int side : {-1, 1}) {
+    const int neighbour = (column + side + texture.cols) % texture.cols;
+    const float predicted = *own + static_cast<float>(side) * slope;
+    const int near = static_cast<int>(std::lround(predicted));
+    if (near < 1 || near > texture.rows - 2) return *own;
+    const std::optional<float> found = RayProfile(texture, near, neighbour, taps).peak(sign);
+    if (!found || std::abs(*found - predicted) > 1.0f) return *own;
+    // A line through the three rows, read at the middle column: their mean.
+    sum += *found - static_cast<float>(side) * slope;
+  }
+  return sum / 3.0f;
+}
+
+}  // namespace omnislam::vision
