@@ -5,7 +5,6 @@
 #include <cmath>
 #include <cstdint>
 #include <optional>
-#include <vector>
 
 namespace omnislam::vision {
 namespace {
@@ -17,18 +16,36 @@ float parabola_vertex(float a, float b, float c) {
   return std::clamp(0.5f * (a - c) / curvature, -0.5f, 0.5f);
 }
 
+// A normalised 1-D Gaussian of `sigma_px` (3 sigma each side, at most kMaxHalfTaps), on
+// the stack: no allocation per call.
+constexpr int kMaxHalfTaps = 15;  // sigma up to 5 px, the configuration's limit
+struct Taps {
+  std::array<float, 2 * kMaxHalfTaps + 1> weight{};
+  int half = 0;
+};
+Taps gaussian_taps(double sigma_px) {
+  Taps taps;
+  taps.half = std::min(kMaxHalfTaps, static_cast<int>(std::ceil(3.0 * sigma_px)));
+  double sum = 0.0;
+  for (int i = -taps.half; i <= taps.half; ++i) sum += std::exp(-0.5 * i * i / (sigma_px * sigma_px));
+  for (int i = -taps.half; i <= taps.half; ++i)
+    taps.weight[static_cast<std::size_t>(i + taps.half)] =
+        static_cast<float>(std::exp(-0.5 * i * i / (sigma_px * sigma_px)) / sum);
+  return taps;
+}
+
 // One column's profile about `row`: the texture smoothed along the column by `taps`, S,
 // and its central differences S(r + 1) - S(r - 1) at rows row - 2 .. row + 2.
 class RayProfile {
  public:
-  RayProfile(const cv::Mat &texture, int row, int column, const std::vector<float> &taps) : row_(row) {
-    const int half = static_cast<int>(taps.size() / 2);
+  RayProfile(const cv::Mat &texture, int row, int column, const Taps &taps) : row_(row) {
+    const int half = taps.half;
     const int last = texture.rows - 1;
     std::array<float, 7> smoothed{};
     for (int i = 0; i < 7; ++i) {
       float sum = 0.0f;
       for (int t = -half; t <= half; ++t)
-        sum += taps[static_cast<std::size_t>(t + half)] *
+        sum += taps.weight[static_cast<std::size_t>(t + half)] *
                texture.at<float>(std::clamp(row - 3 + i + t, 0, last), column);
       smoothed[static_cast<std::size_t>(i)] = sum;
     }
@@ -57,23 +74,12 @@ class RayProfile {
   std::array<float, 5> difference_{};
 };
 
-std::vector<float> gaussian_taps(double sigma_px) {
-  const int half = static_cast<int>(std::ceil(3.0 * sigma_px));
-  std::vector<float> taps(static_cast<std::size_t>(2 * half + 1));
-  double sum = 0.0;
-  for (int i = -half; i <= half; ++i) sum += std::exp(-0.5 * i * i / (sigma_px * sigma_px));
-  for (int i = -half; i <= half; ++i)
-    taps[static_cast<std::size_t>(i + half)] =
-        static_cast<float>(std::exp(-0.5 * i * i / (sigma_px * sigma_px)) / sum);
-  return taps;
-}
-
 }  // namespace
 
 float ray_subpixel_row(const cv::Mat &texture, const EdgeImage &edges, const EdgePoint &edge, int column,
                        double sigma_px) {
   if (!(sigma_px > 0.0)) return edge.row_subpx;
-  const std::vector<float> taps = gaussian_taps(sigma_px);
+  const Taps taps = gaussian_taps(sigma_px);
   const RayProfile own_profile(texture, edge.row, column, taps);
   const float sign = own_profile.polarity();
   const std::optional<float> own = own_profile.peak(sign);
