@@ -49,6 +49,20 @@ cv::Mat steep_step_panorama() {
   return pano;
 }
 
+// A panorama's edges, texture and selected candidates, as the scan reconstructor makes them.
+struct Selected {
+  EdgeImage edges;
+  cv::Mat texture;
+  ColumnEdges candidates;
+};
+Selected select_edges(const cv::Mat &pano, const EdgeSelectionConfig &config) {
+  Selected selected;
+  EdgeDetector().detect(pano, selected.edges);
+  make_texture(pano, {}, selected.texture);
+  select_nearest_horizontal_edges(selected.edges, selected.texture, config, selected.candidates);
+  return selected;
+}
+
 }  // namespace
 
 TEST_CASE("unwarp + edges find the convention image's floor-wall boundary at its model rows",
@@ -142,14 +156,9 @@ TEST_CASE("edge selection: horizontal only, nearest (bottom) first, capped per c
     cv::rectangle(pano, cv::Rect(0, 40 + 30 * band, 180, 15), cv::Scalar(200), cv::FILLED);
   }
   cv::rectangle(pano, cv::Rect(270, 0, 90, 225), cv::Scalar(200), cv::FILLED);  // vertical step at column 270
-  EdgeImage edges;
-  EdgeDetector().detect(pano, edges);
-  cv::Mat texture;
-  make_texture(pano, {}, texture);
   EdgeSelectionConfig config;
   config.max_edges_per_column = 3;
-  ColumnEdges candidates;
-  select_nearest_horizontal_edges(edges, texture, config, candidates);
+  const ColumnEdges candidates = select_edges(pano, config).candidates;
   const auto column = candidates.column(90);
   REQUIRE(column.size() == 3);
   // Bottom-up: the lower boundary of the lowest band (row 174.5 between 174 and 175), ...
@@ -197,15 +206,9 @@ TEST_CASE("Blackman kernel: 7 taps, symmetric, normalised", "[vision][texture]")
 TEST_CASE(
     "an edge's row along its ray: a steep edge whose contrast changes along it is found where it crosses",
     "[vision][selection]") {
-  const cv::Mat pano = steep_step_panorama();
-  EdgeImage edges;
-  EdgeDetector().detect(pano, edges);
-  cv::Mat texture;
-  make_texture(pano, {}, texture);
   EdgeSelectionConfig config;
   config.min_relative_contrast = 0.0;
-  ColumnEdges candidates;
-  select_nearest_horizontal_edges(edges, texture, config, candidates);
+  const auto [edges, texture, candidates] = select_edges(steep_step_panorama(), config);
   double canny_error = 0.0, ray_error = 0.0;
   int found = 0;
   for (int column = 160; column <= 200; ++column) {
