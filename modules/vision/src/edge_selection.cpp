@@ -7,6 +7,8 @@
 #include <cstring>
 #include <vector>
 
+#include "parabola.hpp"
+
 namespace omnislam::vision {
 namespace {
 
@@ -18,13 +20,6 @@ int abs_row_gradient(const cv::Mat &grad_row, int row, int column) {
 int byte_of_lowest_bit(std::uint64_t word) {
   const int byte = std::countr_zero(word) / 8;
   return std::endian::native == std::endian::little ? byte : 7 - byte;
-}
-
-// Vertex of the parabola through (-1, a), (0, b), (1, c), clamped to half a pixel.
-float parabola_offset(float a, float b, float c) {
-  const float curvature = a - 2.0f * b + c;
-  if (!(curvature < 0.0f)) return 0.0f;
-  return std::clamp(0.5f * (a - c) / curvature, -0.5f, 0.5f);
 }
 
 }  // namespace
@@ -107,8 +102,8 @@ SelectionStats select_nearest_horizontal_edges(const EdgeImage &edges, const cv:
       ++stats.low_contrast;
       return;
     }
-    const float offset =
-        parabola_offset(static_cast<float>(above), static_cast<float>(centre), static_cast<float>(below));
+    const float offset = parabola_vertex_offset(static_cast<float>(above), static_cast<float>(centre),
+                                                static_cast<float>(below));
     out.push(column, {row, static_cast<float>(row) + offset, static_cast<float>(centre)});
     ++kept[static_cast<std::size_t>(column)];
   };

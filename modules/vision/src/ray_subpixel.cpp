@@ -6,15 +6,10 @@
 #include <cstdint>
 #include <optional>
 
+#include "parabola.hpp"
+
 namespace omnislam::vision {
 namespace {
-
-// Vertex of the parabola through (-1, a), (0, b), (1, c), clamped to half a pixel.
-float parabola_vertex(float a, float b, float c) {
-  const float curvature = a - 2.0f * b + c;
-  if (!(curvature < 0.0f)) return 0.0f;
-  return std::clamp(0.5f * (a - c) / curvature, -0.5f, 0.5f);
-}
 
 // A normalised 1-D Gaussian of `sigma_px` (3 sigma each side, at most kMaxHalfTaps), on
 // the stack: no allocation per call.
@@ -66,7 +61,7 @@ class RayProfile {
     if (g[3] > g[best]) best = 3;
     if (!(g[best] > 0.0f) || g[best - 1] > g[best] || g[best + 1] > g[best]) return std::nullopt;
     return static_cast<float>(row_ + static_cast<int>(best) - 2) +
-           parabola_vertex(g[best - 1], g[best], g[best + 1]);
+           parabola_vertex_offset(g[best - 1], g[best], g[best + 1]);
   }
 
  private:
