@@ -184,12 +184,12 @@ void per_loop_on_one_thread(const Data &data, const std::vector<slam::Points2> &
   }
   std::printf(
       "  one thread, loop closure %-10s: per-frame SLAM p99 loop 1 %.2f ms, loop %d %.2f ms (ratio %.2f); "
-      "%d closures; max online error loop 1 %.1f mm, loop %d %.1f mm\n",
+      "%d closures, %zu keyframes; max online error loop 1 %.1f mm, loop %d %.1f mm\n",
       !config.loop_closure.enabled ? "off"
       : background                 ? "background"
                                    : "inline",
       p99(ms.front()), loops, p99(ms.back()), p99(ms.back()) / p99(ms.front()), slam.loop_closures(),
-      1000.0 * max_error_m.front(), loops, 1000.0 * max_error_m.back());
+      slam.keyframes().keyframes().size(), 1000.0 * max_error_m.front(), loops, 1000.0 * max_error_m.back());
 }
 
 }  // namespace

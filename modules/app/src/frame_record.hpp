@@ -17,6 +17,7 @@ namespace omnislam::app {
   record.integrated = frame.estimate.integrated;
   record.localized = frame.localized;
   record.keyframe = frame.estimate.keyframe;
+  record.revisit = frame.estimate.revisit;
   record.loop_closed = frame.estimate.loop_closed;
   record.attempt = frame.estimate.attempt;
   record.srel_percent = frame.estimate.registration.srel_percent;

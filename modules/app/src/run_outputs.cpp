@@ -204,6 +204,8 @@ void OutputWriter::write_all(const RunRecord &all, const slam::PointMap &map, co
   if (all.localizing) summary["not_localized"] = all.frames.size() - run.frames.size();
   summary["keyframes"] =
       std::count_if(run.frames.begin(), run.frames.end(), [](auto &f) { return f.keyframe; });
+  summary["revisits"] =
+      std::count_if(run.frames.begin(), run.frames.end(), [](auto &f) { return f.revisit; });
   summary["loop_closures"] =
       std::count_if(run.frames.begin(), run.frames.end(), [](auto &f) { return f.loop_closed; });
   summary["map_points"] = map.points().size();

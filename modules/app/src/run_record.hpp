@@ -26,6 +26,7 @@ struct FrameRecord {
   bool integrated = false;
   bool localized = true;     ///< false: still searching for its pose on a saved map (no pose)
   bool keyframe = false;     ///< became a keyframe of the pose graph
+  bool revisit = false;      ///< revisited a keyframe: integrated, anchored to it, no new keyframe
   bool loop_closed = false;  ///< a loop closure corrected the graph at this frame
   slam::Attempt attempt = slam::Attempt::kNone;
   double srel_percent = 0.0;

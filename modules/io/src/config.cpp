@@ -204,6 +204,7 @@ void read_loop_closure(YamlSection &section, slam::LoopClosureConfig &loops) {
   section.read("loop_chi2_limit", loops.graph.loop_chi2_limit);
   section.read("loop_loss_scale", loops.graph.loop_loss_scale);
   section.read("rebuild_min_shift_m", loops.rebuild_min_shift_m);
+  section.read("reuse_keyframes", loops.reuse_keyframes);
   for (const auto &[key, value] : {std::pair{"keyframe_distance_m", keyframes.keyframe_distance_m},
                                    {"keyframe_angle_deg", keyframes.keyframe_angle_rad},
                                    {"edge_floor_xy_m", keyframes.edge_floor_xy_m},

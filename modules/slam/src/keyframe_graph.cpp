@@ -138,6 +138,7 @@ KeyframeGraph::KeyframeGraph(KeyframeConfig config, const KeyframeGraphState &st
   for (const KeyframeGraphState::SavedEdge &edge : state.edges)
     graph_.add_edge({edge.from, edge.to, isometry_of(edge.T_from_to), edge.information, edge.loop});
   integration_order_ = state.integration_order;
+  anchor_ = last();
 }
 
 KeyframeGraphState KeyframeGraph::state() const {
@@ -153,14 +154,56 @@ KeyframeGraphState KeyframeGraph::state() const {
 }
 
 KeyframeGraph::FrameAnchor KeyframeGraph::anchor(const Eigen::Isometry2d &T_map_base) const {
-  if (keyframes_.empty()) return {-1, T_map_base};
-  return {last(), keyframes_.back().T_map_keyframe.inverse() * T_map_base};
+  if (anchor_ < 0) return {-1, T_map_base};
+  return {anchor_, keyframes_[static_cast<std::size_t>(anchor_)].T_map_keyframe.inverse() * T_map_base};
 }
 
 void KeyframeGraph::add_pose(const Eigen::Isometry2d &T_map_base) {
   frames_.push_back(anchor(T_map_base));
   if (!keyframes_.empty()) path_m_ += (T_map_base.translation() - last_frame_.translation()).norm();
   last_frame_ = T_map_base;
+}
+
+int KeyframeGraph::revisited(const Eigen::Isometry2d &T_map_base, double min_path_gap_m) const {
+  // The places a loop edge joins: each was matched against another visit's scans by a fit
+  // constrained in every direction (the loop search refuses a plain corridor's).
+  std::vector<char> matched(keyframes_.size(), 0);
+  for (const PoseGraphEdge &edge : graph_.edges()) {
+    if (!edge.loop) continue;
+    matched[static_cast<std::size_t>(edge.from)] = 1;
+    matched[static_cast<std::size_t>(edge.to)] = 1;
+  }
+  int nearest = -1;
+  double nearest_m = config_.keyframe_distance_m;
+  for (int k = 0; k <= last(); ++k) {
+    const Keyframe &keyframe = keyframes_[static_cast<std::size_t>(k)];
+    if (path_m_ - keyframe.path_m < min_path_gap_m) break;  // path_m grows with k
+    if (!matched[static_cast<std::size_t>(k)]) continue;
+    const double distance_m = (keyframe.T_map_keyframe.translation() - T_map_base.translation()).norm();
+    if (distance_m < nearest_m) {
+      nearest = k;
+      nearest_m = distance_m;
+    }
+  }
+  return nearest;
+}
+
+void KeyframeGraph::add_revisit(int keyframe, const Points2 &scan_base, const Eigen::Isometry2d &T_map_base) {
+  if (keyframe < 0 || keyframe > last())
+    throw std::out_of_range("KeyframeGraph::add_revisit: keyframe " + std::to_string(keyframe) + " of " +
+                            std::to_string(keyframes_.size()));
+  path_m_ += (T_map_base.translation() - last_frame_.translation()).norm();
+  last_frame_ = T_map_base;
+  anchor_ = keyframe;
+  frames_.push_back(anchor(T_map_base));
+  store_scan(scan_base);
+}
+
+void KeyframeGraph::store_scan(const Points2 &scan_base) {
+  Keyframe &keyframe = keyframes_[static_cast<std::size_t>(anchor_)];
+  keyframe.scans_keyframe.push_back(
+      std::make_shared<const Points2>(transformed(scan_base, frames_.back().T_keyframe_base)));
+  integration_order_.emplace_back(anchor_, static_cast<int>(keyframe.scans_keyframe.size()) - 1);
 }
 
 bool KeyframeGraph::add_integrated(const Points2 &scan_base, const Eigen::Isometry2d &T_map_base,
@@ -171,7 +214,7 @@ bool KeyframeGraph::add_integrated(const Points2 &scan_base, const Eigen::Isomet
   // starts a keyframe of its own: its scan belongs to none of the saved keyframes.
   bool is_keyframe = keyframes_.empty() || !chained_;
   if (!is_keyframe) {
-    const Eigen::Isometry2d step = keyframes_.back().T_map_keyframe.inverse() * T_map_base;
+    const Eigen::Isometry2d step = keyframes_[static_cast<std::size_t>(anchor_)].T_map_keyframe.inverse() * T_map_base;
     is_keyframe = step.translation().norm() >= config_.keyframe_distance_m ||
                   std::abs(yaw_rad_of(step)) >= config_.keyframe_angle_rad;
   }
@@ -180,22 +223,22 @@ bool KeyframeGraph::add_integrated(const Points2 &scan_base, const Eigen::Isomet
     if (node > 0 && chained_) {
       // The sequential edge: the relative pose the tracking produced, with the
       // tracking's covariance over it plus the floor.
-      const Keyframe &previous = keyframes_.back();
+      const Keyframe &previous = keyframes_[static_cast<std::size_t>(anchor_)];
       const Eigen::Isometry2d T_previous_current = previous.T_map_keyframe.inverse() * T_map_base;
       const Eigen::Vector3d floor(config_.edge_floor_xy_m, config_.edge_floor_xy_m,
                                   config_.edge_floor_yaw_rad);
       const Eigen::Matrix3d covariance =
           rotated_covariance(tracked_covariance, previous.T_map_keyframe.linear().transpose()) +
           Eigen::Matrix3d(floor.cwiseAbs2().asDiagonal());
-      graph_.add_edge({node - 1, node, T_previous_current, covariance.inverse(), false});
+      graph_.add_edge({anchor_, node, T_previous_current, covariance.inverse(), false});
     }
     keyframes_.push_back({T_map_base, path_m_, {}});
     chained_ = true;
   }
+  // An integrated frame lays new trail: it belongs to the last keyframe.
+  anchor_ = last();
   frames_.push_back(anchor(T_map_base));
-  keyframes_.back().scans_keyframe.push_back(
-      std::make_shared<const Points2>(transformed(scan_base, frames_.back().T_keyframe_base)));
-  integration_order_.emplace_back(last(), static_cast<int>(keyframes_.back().scans_keyframe.size()) - 1);
+  store_scan(scan_base);
   return is_keyframe;
 }
 
@@ -259,6 +302,7 @@ KeyframeGraph KeyframeGraph::without_trajectory() const {
   copy.path_m_ = path_m_;
   copy.last_frame_ = last_frame_;
   copy.chained_ = chained_;
+  copy.anchor_ = anchor_;
   return copy;
 }
 
@@ -278,6 +322,13 @@ Eigen::Isometry2d KeyframeGraph::adopt(const KeyframeGraph &solved, std::size_t 
   const std::size_t copied = solved.keyframes_.size();
   if (copied == 0 || copied > keyframes_.size()) return Eigen::Isometry2d::Identity();
   const Eigen::Isometry2d T_corrected_tracked = newest_correction(solved.keyframes_, keyframes_, copied);
+  // The live pose follows the keyframe it is tracked against: the newest (or one made since
+  // the copy, which moves with it), or an older one it revisits, which moves as solved.
+  const auto anchor = static_cast<std::size_t>(anchor_);
+  const Eigen::Isometry2d T_anchor_corrected =
+      anchor_ >= 0 && anchor + 1 < copied
+          ? orthonormalized(solved.keyframes_[anchor].T_map_keyframe * keyframes_[anchor].T_map_keyframe.inverse())
+          : T_corrected_tracked;
   for (std::size_t k = 0; k < keyframes_.size(); ++k)
     keyframes_[k].T_map_keyframe =
         corrected_pose(k, copied, solved.keyframes_, keyframes_, T_corrected_tracked);
@@ -287,7 +338,7 @@ Eigen::Isometry2d KeyframeGraph::adopt(const KeyframeGraph &solved, std::size_t 
   for (std::size_t k = copied; k < keyframes_.size(); ++k) graph.add_node(keyframes_[k].T_map_keyframe);
   for (std::size_t e = copied_edges; e < graph_.edges().size(); ++e) graph.add_edge(graph_.edges()[e]);
   graph_ = std::move(graph);
-  return T_corrected_tracked;
+  return T_anchor_corrected;
 }
 
 std::vector<Eigen::Isometry2d> KeyframeGraph::trajectory() const {

@@ -190,6 +190,7 @@ void Slam::resume(std::vector<MapPoint> points, int integrations, const Eigen::I
   search_due_ = false;
   job_out_ = false;
   catch_up_job_.reset();
+  tied_ = false;
   ++generation_;
   map_ = PointMap(config_.map, std::move(points), integrations);
   started_ = true;
@@ -234,6 +235,7 @@ void Slam::set_pose(const Eigen::Isometry2d &T_map_base, const Eigen::Matrix3d &
   walk_dof_ = std::numeric_limits<double>::infinity();
   uncommitted_covariance_ = covariance;     // the operator's pose is as rough as they say
   since_keyframe_covariance_ = covariance;  // so is its relation to the last keyframe
+  tied_ = false;                            // until a loop closure confirms the jump
   last_step_ = Eigen::Isometry2d::Identity();
   // The scans before the jump sit at the old poses: the whole map stands in for them.
   if (!map_.empty()) recent_scans_map_.assign(1, map_.index().points());
@@ -265,6 +267,7 @@ Eigen::Isometry2d Slam::update_graph(const Points2 &scan_base, FrameEstimate &es
   estimate.keyframe = keyframes_.add_integrated(scan_base, estimate.T_map_base, since_keyframe_covariance_);
   if (!estimate.keyframe) return estimate.T_map_base;
   since_keyframe_covariance_.setZero();
+  tied_ = false;  // new trail: a loop closure must tie it again before places are revisited
   search_due_ = true;
   if (config_.loop_closure.background) return estimate.T_map_base;  // the caller runs the job
   search_due_ = false;
@@ -303,6 +306,7 @@ Eigen::Isometry2d Slam::take_result(LoopResult result) {
   last_loop_ = match;
   ++loop_closures_;
   closed_since_frame_ = true;
+  tied_ = true;
   const Eigen::Isometry2d T_corrected_tracked = keyframes_.adopt(*result.solved, result.copied_edges);
   if (result.map) {
     // The rebuilt map holds the scans up to the job; those integrated since follow.
@@ -402,9 +406,24 @@ FrameEstimate Slam::process(const Points2 &scan_base, const std::optional<Eigen:
     // A frame without odometry is registered but never changes the map: along a corridor
     // the scan fits anywhere, and only odometry tells where.
     const bool odometry_gap = config_.use_odometry && !T_odom_base;
-    if (!config_.localization_only && !odometry_gap) {
+    const LoopClosureConfig &loops = config_.loop_closure;
+    const bool revisiting = loops.enabled && loops.reuse_keyframes && tied_ && !config_.localization_only &&
+                            !odometry_gap;
+    const int revisited =
+        revisiting ? keyframes_.revisited(estimate.T_map_base, loops.min_path_gap_m) : -1;
+    if (revisited >= 0) {
+      // A mapped place: the frame follows the keyframe it revisits, and its relation to
+      // that keyframe is this registration's (the map there holds the keyframe's scans).
+      // Its scan still refines the map (fused points average over every visit: on six laps
+      // of the synthetic L-room, seeds 1-6, the first lap's map alone left the later laps'
+      // worst frame 40 mm off on average, the refined map 29 mm).
       map_.integrate(transformed(scan_base, estimate.T_map_base));
-      if (config_.loop_closure.enabled) {
+      keyframes_.add_revisit(revisited, scan_base, estimate.T_map_base);
+      since_keyframe_covariance_ = term;
+      estimate.revisit = in_graph = true;
+    } else if (!config_.localization_only && !odometry_gap) {
+      map_.integrate(transformed(scan_base, estimate.T_map_base));
+      if (loops.enabled) {
         estimate.T_map_base = update_graph(scan_base, estimate);
         in_graph = true;
       }

@@ -107,13 +107,26 @@ class KeyframeGraph {
   [[nodiscard]] KeyframeGraphState state() const;
 
   /// Records an integrated frame at `T_map_base` with its scan (base_link); it becomes a
-  /// keyframe when far enough from the last one, joined to it by a sequential edge whose
-  /// covariance is `tracked_covariance` (map frame: the tracking's uncertainty of this pose
-  /// relative to the last keyframe) plus the floor. Returns whether it did.
+  /// keyframe when far enough from the keyframe the frames are anchored to (the last one,
+  /// or the one last revisited), joined to it by a sequential edge whose covariance is
+  /// `tracked_covariance` (map frame: the tracking's uncertainty of this pose relative to
+  /// that keyframe) plus the floor. Returns whether it did.
   bool add_integrated(const Points2 &scan_base, const Eigen::Isometry2d &T_map_base,
                       const Eigen::Matrix3d &tracked_covariance);
-  /// Records a frame that was not integrated (only its pose, relative to the last keyframe).
+  /// Records a frame that was not integrated (only its pose, relative to the keyframe the
+  /// frames are anchored to: the last one, or the one revisited).
   void add_pose(const Eigen::Isometry2d &T_map_base);
+
+  /// The keyframe a frame at `T_map_base` revisits: the nearest within keyframe_distance_m
+  /// that lies at least `min_path_gap_m` back along the path (a place mapped before, not the
+  /// trail just laid) and that a loop edge joins (matched by a fit constrained in every
+  /// direction), or -1.
+  [[nodiscard]] int revisited(const Eigen::Isometry2d &T_map_base, double min_path_gap_m) const;
+  /// Records an integrated frame in a place the graph already holds: anchored to keyframe
+  /// `keyframe` (its pose relative to it, so it follows the graph) and its scan (base_link)
+  /// stored there, no new keyframe. The next keyframe is joined to `keyframe` by its
+  /// sequential edge.
+  void add_revisit(int keyframe, const Points2 &scan_base, const Eigen::Isometry2d &T_map_base);
 
   /// Adds a loop edge: keyframe `current` seen at T_candidate_current from `candidate`.
   void add_loop(int candidate, int current, const Eigen::Isometry2d &T_candidate_current,
@@ -142,7 +155,9 @@ class KeyframeGraph {
   /// Takes the poses and edges of `solved`, a copy of this graph made when it had
   /// `copied_edges` edges and then given loop edges and optimised. Keyframes and edges
   /// added here since the copy stay; the new keyframes move with the copy's newest
-  /// keyframe. Returns that keyframe's correction (T_corrected_tracked, map frame).
+  /// keyframe. Returns the correction of the keyframe new frames are anchored to
+  /// (T_corrected_tracked, map frame): the copy's newest keyframe's, unless an older
+  /// keyframe is being revisited.
   Eigen::Isometry2d adopt(const KeyframeGraph &solved, std::size_t copied_edges);
   /// The stored scans from the `first`-th integrated one on, each with the pose it would
   /// have once `solved` (as for adopt) is adopted.
@@ -161,6 +176,8 @@ class KeyframeGraph {
   /// How many frames are recorded (trajectory()'s size).
   [[nodiscard]] int frame_count() const { return static_cast<int>(frames_.size()); }
   [[nodiscard]] int last() const { return static_cast<int>(keyframes_.size()) - 1; }
+  /// The keyframe new frames are anchored to (-1 before the first).
+  [[nodiscard]] int anchor_keyframe() const { return anchor_; }
   [[nodiscard]] const PoseGraph &graph() const { return graph_; }
   [[nodiscard]] const KeyframeConfig &config() const { return config_; }
 
@@ -170,6 +187,8 @@ class KeyframeGraph {
     Eigen::Isometry2d T_keyframe_base = Eigen::Isometry2d::Identity();
   };
   [[nodiscard]] FrameAnchor anchor(const Eigen::Isometry2d &T_map_base) const;
+  /// Stores the last recorded frame's scan in the keyframe it is anchored to.
+  void store_scan(const Points2 &scan_base);
 
   KeyframeConfig config_;
   std::vector<Keyframe> keyframes_;
@@ -179,6 +198,9 @@ class KeyframeGraph {
   PoseGraph graph_;
   double path_m_ = 0.0;  ///< travelled so far, summed frame to frame
   Eigen::Isometry2d last_frame_ = Eigen::Isometry2d::Identity();
+  /// The keyframe frames are anchored to and the next keyframe's sequential edge starts
+  /// from: the last keyframe, or the old one a revisiting frame was anchored to.
+  int anchor_ = -1;
   /// false after a resume whose pose does not continue the saved tracking: the next
   /// integrated frame is a keyframe without a sequential edge.
   bool chained_ = true;

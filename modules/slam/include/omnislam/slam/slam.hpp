@@ -90,6 +90,9 @@ struct FrameEstimate {
   TrimmedIcpResult registration;                         ///< the accepted one, or the last tried
   Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();  ///< (x, y, yaw) in the map frame
   bool keyframe = false;                                 ///< the frame became a keyframe of the pose graph
+  /// The frame revisited a keyframe (LoopClosureConfig::reuse_keyframes): integrated and
+  /// anchored to that keyframe, not a keyframe itself.
+  bool revisit = false;
   /// A loop closure corrected the graph (and T_map_base) at this frame: its own keyframe's
   /// (inline loop closure) or a job's result applied just before it (background).
   bool loop_closed = false;
@@ -229,6 +232,9 @@ class Slam {
   std::uint64_t generation_ = 0;         ///< counts resumes: older jobs' results are ignored
   bool closed_since_frame_ = false;      ///< a result closed a loop since the last frame
   bool rebuilt_since_frame_ = false;     ///< ... and rebuilt the map
+  /// A confirmed loop closure tied the robot to the graph and no keyframe was made since:
+  /// frames in mapped places revisit keyframes (LoopClosureConfig::reuse_keyframes).
+  bool tied_ = false;
   /// A resumed map: the base every rebuild starts from (shared with the jobs).
   std::shared_ptr<const std::vector<MapPoint>> restored_points_;
   int restored_integrations_ = 0;
