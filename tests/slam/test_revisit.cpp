@@ -127,9 +127,15 @@ TEST_CASE("keyframe graph: revisiting frames follow their keyframe, the next key
   CHECK(trajectory[static_cast<std::size_t>(frames)].translation().isApprox(Eigen::Vector2d(1.1, 0.1), 1e-12));
   CHECK(trajectory[static_cast<std::size_t>(frames) + 2].translation().isApprox(Eigen::Vector2d(1.7, 0.1),
                                                                                  1e-12));
-  // A saved graph continues from its last keyframe.
+  // A saved graph continues from its last keyframe ...
   const KeyframeGraph restored(KeyframeConfig{}, graph.state(), true);
   CHECK(restored.anchor_keyframe() == restored.last());
+  // ... unless it was revisiting a matched keyframe out of that one's reach (the next
+  // keyframe then joins the keyframe revisited, as it would have in the saved run).
+  KeyframeGraph revisiting = graph_along_x(6.0);
+  revisiting.add_revisit(2, kScan, pose(1.1, 0.1, 0.0));
+  const KeyframeGraph resumed(KeyframeConfig{}, revisiting.state(), true);
+  CHECK(resumed.anchor_keyframe() == 2);
   CHECK_THROWS_AS(graph.add_revisit(graph.last() + 1, kScan, pose(0, 0, 0)), std::out_of_range);
 }
 

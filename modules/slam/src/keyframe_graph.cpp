@@ -138,7 +138,13 @@ KeyframeGraph::KeyframeGraph(KeyframeConfig config, const KeyframeGraphState &st
   for (const KeyframeGraphState::SavedEdge &edge : state.edges)
     graph_.add_edge({edge.from, edge.to, isometry_of(edge.T_from_to), edge.information, edge.loop});
   integration_order_ = state.integration_order;
+  // The saved run was revisiting when its last frame lies beyond a keyframe's reach of the
+  // last keyframe but within that of a matched one (a snapshot does not name the anchor).
   anchor_ = last();
+  if (anchor_ >= 0 && (keyframes_.back().T_map_keyframe.translation() - last_frame_.translation()).norm() >=
+                          config_.keyframe_distance_m) {
+    if (const int revisited = this->revisited(last_frame_, 0.0); revisited >= 0) anchor_ = revisited;
+  }
 }
 
 KeyframeGraphState KeyframeGraph::state() const {
