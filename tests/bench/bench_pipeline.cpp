@@ -6,6 +6,7 @@
 // without the other threads' noise. Run it through scripts/bench-pipeline (2 cores).
 //
 //   bench_pipeline [DATASET] [--loops N] [--live-seconds S] [--rate HZ] [--no-loop-closure]
+//                  [--no-reuse-keyframes]
 //                  [--loop-closure inline|background]
 // --loop-closure sets where loop closure runs in both runs; by default the pipeline's
 // choice by mode: inline in the throughput (replay) run, background in the live run.
@@ -210,6 +211,8 @@ int main(int argc, char **argv) {
       rate_hz = std::atof(argv[++i]);
     } else if (arg == "--no-loop-closure") {
       slam_config.loop_closure.enabled = false;
+    } else if (arg == "--no-reuse-keyframes") {
+      slam_config.loop_closure.reuse_keyframes = false;  // every lap makes its keyframes
     } else if (arg == "--loop-closure" && i + 1 < argc) {
       const std::string where = argv[++i];
       loop_closure =

@@ -59,10 +59,11 @@ Run run(Slam &slam, const std::vector<Eigen::Isometry2d> &truth, std::uint64_t s
       // The keyframe the live pose is tracked against: the job's newest (or one made since,
       // which moves with it), or an older one being revisited.
       const int anchor = slam.keyframes().anchor_keyframe();
-      const std::size_t follows =
-          anchor >= 0 && static_cast<std::size_t>(anchor) + 1 < copied ? static_cast<std::size_t>(anchor) : copied - 1;
-      const Eigen::Isometry2d followed_before = copied > 0 ? slam.keyframes().keyframes()[follows].T_map_keyframe
-                                                           : Eigen::Isometry2d::Identity();
+      const std::size_t follows = anchor >= 0 && static_cast<std::size_t>(anchor) + 1 < copied
+                                      ? static_cast<std::size_t>(anchor)
+                                      : copied - 1;
+      const Eigen::Isometry2d followed_before =
+          copied > 0 ? slam.keyframes().keyframes()[follows].T_map_keyframe : Eigen::Isometry2d::Identity();
       const int closures = slam.loop_closures();
       slam.apply_loop_result(run_loop_job(std::move(*out_job)));
       out_job.reset();

@@ -63,8 +63,7 @@ LapsRun run_laps(const SlamConfig &config, int laps, std::uint64_t seed) {
     run.optimised_max_m =
         std::max(run.optimised_max_m, (optimised[i].translation() - expected.translation()).norm());
   }
-  run.online_final_m =
-      (last.translation() - (truth.front().inverse() * truth.back()).translation()).norm();
+  run.online_final_m = (last.translation() - (truth.front().inverse() * truth.back()).translation()).norm();
   run.keyframes = static_cast<int>(slam.keyframes().keyframes().size());
   run.stored_scans = slam.keyframes().integrations();
   run.loop_closures = slam.loop_closures();
@@ -124,9 +123,10 @@ TEST_CASE("keyframe graph: revisiting frames follow their keyframe, the next key
   CHECK(graph.anchor_keyframe() == graph.last());
   // The revisiting frames are where they were recorded, relative to their keyframes.
   const auto trajectory = graph.trajectory();
-  CHECK(trajectory[static_cast<std::size_t>(frames)].translation().isApprox(Eigen::Vector2d(1.1, 0.1), 1e-12));
+  CHECK(
+      trajectory[static_cast<std::size_t>(frames)].translation().isApprox(Eigen::Vector2d(1.1, 0.1), 1e-12));
   CHECK(trajectory[static_cast<std::size_t>(frames) + 2].translation().isApprox(Eigen::Vector2d(1.7, 0.1),
-                                                                                 1e-12));
+                                                                                1e-12));
   // A saved graph continues from its last keyframe ...
   const KeyframeGraph restored(KeyframeConfig{}, graph.state(), true);
   CHECK(restored.anchor_keyframe() == restored.last());
@@ -150,11 +150,11 @@ TEST_CASE("SLAM: later laps revisit the first lap's keyframes; the graph grows w
     const LapsRun six_growing = run_laps(growing, 6, seed);
     INFO("seed " << seed << ": keyframes / stored scans / revisits / closures / optimised max: 2 laps "
                  << two.keyframes << " / " << two.stored_scans << " / " << two.revisits << " / "
-                 << two.loop_closures << " / " << two.optimised_max_m << " m; 6 laps " << six.keyframes << " / "
-                 << six.stored_scans << " / " << six.revisits << " / " << six.loop_closures << " / "
+                 << two.loop_closures << " / " << two.optimised_max_m << " m; 6 laps " << six.keyframes
+                 << " / " << six.stored_scans << " / " << six.revisits << " / " << six.loop_closures << " / "
                  << six.optimised_max_m << " m; without reuse 2 laps " << two_growing.keyframes
-                 << " keyframes, 6 laps " << six_growing.keyframes << " / "
-                 << six_growing.stored_scans << " / " << six_growing.optimised_max_m << " m");
+                 << " keyframes, 6 laps " << six_growing.keyframes << " / " << six_growing.stored_scans
+                 << " / " << six_growing.optimised_max_m << " m");
     CHECK(two.loop_closures > 0);
     CHECK(two.revisits > 0);
     // Without reuse every lap adds its keyframes; with it, only where no keyframe there

@@ -220,7 +220,8 @@ bool KeyframeGraph::add_integrated(const Points2 &scan_base, const Eigen::Isomet
   // starts a keyframe of its own: its scan belongs to none of the saved keyframes.
   bool is_keyframe = keyframes_.empty() || !chained_;
   if (!is_keyframe) {
-    const Eigen::Isometry2d step = keyframes_[static_cast<std::size_t>(anchor_)].T_map_keyframe.inverse() * T_map_base;
+    const Eigen::Isometry2d step =
+        keyframes_[static_cast<std::size_t>(anchor_)].T_map_keyframe.inverse() * T_map_base;
     is_keyframe = step.translation().norm() >= config_.keyframe_distance_m ||
                   std::abs(yaw_rad_of(step)) >= config_.keyframe_angle_rad;
   }
@@ -332,9 +333,9 @@ Eigen::Isometry2d KeyframeGraph::adopt(const KeyframeGraph &solved, std::size_t 
   // the copy, which moves with it), or an older one it revisits, which moves as solved.
   const auto anchor = static_cast<std::size_t>(anchor_);
   const Eigen::Isometry2d T_anchor_corrected =
-      anchor_ >= 0 && anchor + 1 < copied
-          ? orthonormalized(solved.keyframes_[anchor].T_map_keyframe * keyframes_[anchor].T_map_keyframe.inverse())
-          : T_corrected_tracked;
+      anchor_ >= 0 && anchor + 1 < copied ? orthonormalized(solved.keyframes_[anchor].T_map_keyframe *
+                                                            keyframes_[anchor].T_map_keyframe.inverse())
+                                          : T_corrected_tracked;
   for (std::size_t k = 0; k < keyframes_.size(); ++k)
     keyframes_[k].T_map_keyframe =
         corrected_pose(k, copied, solved.keyframes_, keyframes_, T_corrected_tracked);

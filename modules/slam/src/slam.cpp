@@ -407,10 +407,9 @@ FrameEstimate Slam::process(const Points2 &scan_base, const std::optional<Eigen:
     // the scan fits anywhere, and only odometry tells where.
     const bool odometry_gap = config_.use_odometry && !T_odom_base;
     const LoopClosureConfig &loops = config_.loop_closure;
-    const bool revisiting = loops.enabled && loops.reuse_keyframes && tied_ && !config_.localization_only &&
-                            !odometry_gap;
-    const int revisited =
-        revisiting ? keyframes_.revisited(estimate.T_map_base, loops.min_path_gap_m) : -1;
+    const bool revisiting =
+        loops.enabled && loops.reuse_keyframes && tied_ && !config_.localization_only && !odometry_gap;
+    const int revisited = revisiting ? keyframes_.revisited(estimate.T_map_base, loops.min_path_gap_m) : -1;
     if (revisited >= 0) {
       // A mapped place: the frame follows the keyframe it revisits, and its relation to
       // that keyframe is this registration's (the map there holds the keyframe's scans).
