@@ -138,6 +138,7 @@ KeyframeGraph::KeyframeGraph(KeyframeConfig config, const KeyframeGraphState &st
   for (const KeyframeGraphState::SavedEdge &edge : state.edges)
     graph_.add_edge({edge.from, edge.to, isometry_of(edge.T_from_to), edge.information, edge.loop});
   integration_order_ = state.integration_order;
+  mark_matched();
   // The saved run was revisiting when its last frame lies beyond a keyframe's reach of the
   // last keyframe but within that of a matched one (a snapshot does not name the anchor).
   anchor_ = last();
@@ -171,20 +172,14 @@ void KeyframeGraph::add_pose(const Eigen::Isometry2d &T_map_base) {
 }
 
 int KeyframeGraph::revisited(const Eigen::Isometry2d &T_map_base, double min_path_gap_m) const {
-  // The places a loop edge joins: each was matched against another visit's scans by a fit
+  // Only places a loop edge joins: each was matched against another visit's scans by a fit
   // constrained in every direction (the loop search refuses a plain corridor's).
-  std::vector<char> matched(keyframes_.size(), 0);
-  for (const PoseGraphEdge &edge : graph_.edges()) {
-    if (!edge.loop) continue;
-    matched[static_cast<std::size_t>(edge.from)] = 1;
-    matched[static_cast<std::size_t>(edge.to)] = 1;
-  }
   int nearest = -1;
   double nearest_m = config_.keyframe_distance_m;
   for (int k = 0; k <= last(); ++k) {
     const Keyframe &keyframe = keyframes_[static_cast<std::size_t>(k)];
     if (path_m_ - keyframe.path_m < min_path_gap_m) break;  // path_m grows with k
-    if (!matched[static_cast<std::size_t>(k)]) continue;
+    if (!matched_[static_cast<std::size_t>(k)]) continue;
     const double distance_m = (keyframe.T_map_keyframe.translation() - T_map_base.translation()).norm();
     if (distance_m < nearest_m) {
       nearest = k;
@@ -203,6 +198,15 @@ void KeyframeGraph::add_revisit(int keyframe, const Points2 &scan_base, const Ei
   anchor_ = keyframe;
   frames_.push_back(anchor(T_map_base));
   store_scan(scan_base);
+}
+
+void KeyframeGraph::mark_matched() {
+  matched_.assign(keyframes_.size(), 0);
+  for (const PoseGraphEdge &edge : graph_.edges()) {
+    if (!edge.loop) continue;
+    matched_[static_cast<std::size_t>(edge.from)] = 1;
+    matched_[static_cast<std::size_t>(edge.to)] = 1;
+  }
 }
 
 void KeyframeGraph::store_scan(const Points2 &scan_base) {
@@ -240,6 +244,7 @@ bool KeyframeGraph::add_integrated(const Points2 &scan_base, const Eigen::Isomet
       graph_.add_edge({anchor_, node, T_previous_current, covariance.inverse(), false});
     }
     keyframes_.push_back({T_map_base, path_m_, {}});
+    matched_.push_back(0);
     chained_ = true;
   }
   // An integrated frame lays new trail: it belongs to the last keyframe.
@@ -252,6 +257,7 @@ bool KeyframeGraph::add_integrated(const Points2 &scan_base, const Eigen::Isomet
 void KeyframeGraph::add_loop(int candidate, int current, const Eigen::Isometry2d &T_candidate_current,
                              const Eigen::Matrix3d &covariance) {
   graph_.add_edge({candidate, current, T_candidate_current, covariance.inverse(), true});
+  matched_[static_cast<std::size_t>(candidate)] = matched_[static_cast<std::size_t>(current)] = 1;
 }
 
 bool KeyframeGraph::has_loop(int current) const {
@@ -262,6 +268,7 @@ bool KeyframeGraph::has_loop(int current) const {
 KeyframeGraph::Correction KeyframeGraph::optimize(const PoseGraphConfig &config) {
   Correction correction;
   correction.solve = graph_.optimize(config);
+  mark_matched();  // the solve may have removed loop edges
   for (int k = 0; k <= last(); ++k) {
     Keyframe &keyframe = keyframes_[static_cast<std::size_t>(k)];
     const Eigen::Isometry2d optimised = graph_.pose(k);
@@ -310,6 +317,7 @@ KeyframeGraph KeyframeGraph::without_trajectory() const {
   copy.last_frame_ = last_frame_;
   copy.chained_ = chained_;
   copy.anchor_ = anchor_;
+  copy.matched_ = matched_;
   return copy;
 }
 
@@ -345,6 +353,7 @@ Eigen::Isometry2d KeyframeGraph::adopt(const KeyframeGraph &solved, std::size_t 
   for (std::size_t k = copied; k < keyframes_.size(); ++k) graph.add_node(keyframes_[k].T_map_keyframe);
   for (std::size_t e = copied_edges; e < graph_.edges().size(); ++e) graph.add_edge(graph_.edges()[e]);
   graph_ = std::move(graph);
+  mark_matched();
   return T_anchor_corrected;
 }
 

@@ -406,23 +406,22 @@ FrameEstimate Slam::process(const Points2 &scan_base, const std::optional<Eigen:
     // A frame without odometry is registered but never changes the map: along a corridor
     // the scan fits anywhere, and only odometry tells where.
     const bool odometry_gap = config_.use_odometry && !T_odom_base;
-    const LoopClosureConfig &loops = config_.loop_closure;
-    const bool revisiting =
-        loops.enabled && loops.reuse_keyframes && tied_ && !config_.localization_only && !odometry_gap;
-    const int revisited = revisiting ? keyframes_.revisited(estimate.T_map_base, loops.min_path_gap_m) : -1;
-    if (revisited >= 0) {
-      // A mapped place: the frame follows the keyframe it revisits, and its relation to
-      // that keyframe is this registration's (the map there holds the keyframe's scans).
-      // Its scan still refines the map (fused points average over every visit: on six laps
-      // of the synthetic L-room, seeds 1-6, the first lap's map alone left the later laps'
-      // worst frame 40 mm off on average, the refined map 29 mm).
+    if (!config_.localization_only && !odometry_gap) {
       map_.integrate(transformed(scan_base, estimate.T_map_base));
-      keyframes_.add_revisit(revisited, scan_base, estimate.T_map_base);
-      since_keyframe_covariance_ = term;
-      estimate.revisit = in_graph = true;
-    } else if (!config_.localization_only && !odometry_gap) {
-      map_.integrate(transformed(scan_base, estimate.T_map_base));
-      if (loops.enabled) {
+      const LoopClosureConfig &loops = config_.loop_closure;
+      const int revisited = loops.enabled && loops.reuse_keyframes && tied_
+                                ? keyframes_.revisited(estimate.T_map_base, loops.min_path_gap_m)
+                                : -1;
+      if (revisited >= 0) {
+        // A mapped place: the frame follows the keyframe it revisits, and its relation to
+        // that keyframe is this registration's (the map there holds the keyframe's scans).
+        // Its scan still refines the map (fused points average over every visit: on six
+        // laps of the synthetic L-room, seeds 1-6, the first lap's map alone left the later
+        // laps' worst frame 40 mm off on average, the refined map 29 mm).
+        keyframes_.add_revisit(revisited, scan_base, estimate.T_map_base);
+        since_keyframe_covariance_ = term;
+        estimate.revisit = in_graph = true;
+      } else if (loops.enabled) {
         estimate.T_map_base = update_graph(scan_base, estimate);
         in_graph = true;
       }

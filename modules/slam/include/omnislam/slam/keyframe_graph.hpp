@@ -189,6 +189,9 @@ class KeyframeGraph {
   [[nodiscard]] FrameAnchor anchor(const Eigen::Isometry2d &T_map_base) const;
   /// Stores the last recorded frame's scan in the keyframe it is anchored to.
   void store_scan(const Points2 &scan_base);
+  /// Recomputes matched_ from the pose graph's loop edges (after a solve or an adoption,
+  /// which may have removed some).
+  void mark_matched();
 
   KeyframeConfig config_;
   std::vector<Keyframe> keyframes_;
@@ -201,6 +204,9 @@ class KeyframeGraph {
   /// The keyframe frames are anchored to and the next keyframe's sequential edge starts
   /// from: the last keyframe, or the old one a revisiting frame was anchored to.
   int anchor_ = -1;
+  /// Per keyframe: a loop edge joins it (revisited() takes only these), kept up to date as
+  /// loop edges come and go, so the per-frame test does not walk the edges.
+  std::vector<char> matched_;
   /// false after a resume whose pose does not continue the saved tracking: the next
   /// integrated frame is a keyframe without a sequential edge.
   bool chained_ = true;
