@@ -66,6 +66,23 @@ TEST_CASE("trajectory grid: scans that cannot change the grid are not kept", "[g
   CHECK(grid.kept_scans() == 3u);
 }
 
+TEST_CASE("trajectory grid: a scan added but not kept is in the grid until the next rebuild", "[grid]") {
+  TrajectoryGrid grid;
+  const Eigen::Isometry2d first = pose(-1.0, 0.0, 0.0);
+  const Eigen::Isometry2d second = pose(1.0, 0.0, 0.0);
+  CHECK(grid.add_scan(0, first, room_scan(first)));
+  const GridImage one = grid.image();
+  // Not kept (the service keeps only the frames the SLAM keeps): added all the same, and
+  // the next scan must move a cell from it, not from the last kept one.
+  CHECK(grid.add_scan(1, second, room_scan(second), false));
+  CHECK_FALSE(grid.add_scan(2, second, room_scan(second)));
+  CHECK(grid.kept_scans() == 1u);
+  CHECK(grid.image().cells != one.cells);
+  grid.rebuild(std::vector<Eigen::Isometry2d>{first, second});
+  const GridImage rebuilt = grid.image();
+  CHECK(rebuilt.cells == one.cells);
+}
+
 TEST_CASE("trajectory grid: rebuilt from corrected poses, the walls move to where they are", "[grid]") {
   // The robot crosses the room; its poses drift 1 cm per step in y (a loop closure later
   // finds the true ones). The scans are what it saw from the true poses.

@@ -242,7 +242,7 @@ TEST_CASE("config: slam.loop_closure, with unknown keys and bad values naming ke
                  "slam:\n  loop_closure:\n    enabled: false\n    keyframe_distance_m: 0.8\n"
                  "    keyframe_angle_deg: 30\n    min_path_gap_m: 8\n    max_candidates: 2\n"
                  "    drift_per_m: 0.05\n    max_window_deg: 6\n    min_overlap: 0.7\n"
-                 "    loop_chi2_limit: 16.27\n"));
+                 "    loop_chi2_limit: 16.27\n    keyframe_max_scans: 8\n"));
   const omnislam::slam::LoopClosureConfig &loops = config.slam.loop_closure;
   CHECK_FALSE(loops.enabled);
   CHECK(loops.keyframes.keyframe_distance_m == 0.8);
@@ -253,6 +253,7 @@ TEST_CASE("config: slam.loop_closure, with unknown keys and bad values naming ke
   CHECK(loops.max_window_rad == Approx(6.0 * 3.14159265358979 / 180.0));
   CHECK(loops.min_overlap == 0.7);
   CHECK(loops.graph.loop_chi2_limit == 16.27);
+  CHECK(loops.keyframes.max_scans == 8);
   CHECK(loops.ambiguity_ratio == defaults.slam.loop_closure.ambiguity_ratio);  // unset keys keep defaults
   CHECK_THROWS_WITH(
       omnislam::io::load_config(
@@ -265,6 +266,18 @@ TEST_CASE("config: slam.loop_closure, with unknown keys and bad values naming ke
   CHECK_THROWS_WITH(omnislam::io::load_config(
                         write_file("loops-count.yaml", "slam:\n  loop_closure:\n    max_candidates: 0\n")),
                     Catch::Contains("max_candidates"));
+  CHECK_THROWS_WITH(omnislam::io::load_config(write_file(
+                        "loops-scans.yaml", "slam:\n  loop_closure:\n    keyframe_max_scans: 0\n")),
+                    Catch::Contains("loops-scans.yaml:3") && Catch::Contains("keyframe_max_scans"));
+}
+
+TEST_CASE("config: slam.map_min_step_m, 0 for the thesis", "[io][config]") {
+  CHECK(omnislam::io::Config{}.slam.map_min_step_m == 0.05);
+  CHECK(omnislam::io::load_config(OMNISLAM_SOURCE_DIR "/deploy/thesis-2008.yaml").slam.map_min_step_m == 0.0);
+  CHECK(omnislam::io::load_config(write_file("step.yaml", "slam:\n  map_min_step_m: 0.1\n"))
+            .slam.map_min_step_m == 0.1);
+  CHECK_THROWS_WITH(omnislam::io::load_config(write_file("step-bad.yaml", "slam:\n  map_min_step_m: -0.1\n")),
+                    Catch::Contains("step-bad.yaml:2") && Catch::Contains("map_min_step_m"));
 }
 
 TEST_CASE("config: the installed defaults (deploy/*.yaml) load", "[io][config]") {

@@ -162,7 +162,10 @@ TEST_CASE("SLAM: later laps revisit the first lap's keyframes; the graph grows w
     // these seeds, against 112).
     CHECK(six_growing.keyframes >= 2 * two_growing.keyframes);
     CHECK(six.keyframes - two.keyframes <= (six_growing.keyframes - two_growing.keyframes) / 4);
-    CHECK(six.stored_scans == six_growing.stored_scans);  // every integrated scan is kept
+    // Each keyframe stores at most max_scans (16): of six laps, the busiest keyframes'
+    // last revisits are tracked, not integrated (449 and 452 scans stored, against 485).
+    CHECK(six.stored_scans < six_growing.stored_scans);
+    CHECK(six.stored_scans > six_growing.stored_scans * 9 / 10);
     // The laps stay as accurate. A revisiting frame's pose is the tracking's on the map,
     // which no later loop closure smooths: worst frame over six laps 43.8 and 32.6 mm on
     // these seeds, 52.6 and 17.1 mm without reuse.

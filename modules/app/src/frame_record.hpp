@@ -18,6 +18,7 @@ namespace omnislam::app {
   record.localized = frame.localized;
   record.keyframe = frame.estimate.keyframe;
   record.revisit = frame.estimate.revisit;
+  record.mapped = frame.estimate.mapped;
   record.loop_closed = frame.estimate.loop_closed;
   record.attempt = frame.estimate.attempt;
   record.srel_percent = frame.estimate.registration.srel_percent;

@@ -218,9 +218,12 @@ int run_service(const std::string &config_file) {
     }
     const bool gridded = publisher || !service.output_dir.empty() || snapshots;
     if (gridded && frame.trajectory) occupancy.rebuild(*frame.trajectory);
+    // Kept for the rebuilds after loop closures only where the SLAM keeps the frame's scan
+    // for its own (bounded per keyframe): a place driven through again and again grows neither.
     if (gridded && !frame.skipped())
       occupancy.add_scan(frame.estimate.trajectory_index, frame.estimate.T_map_base,
-                         scan_rays(frame.scan, config.scan.camera));
+                         scan_rays(frame.scan, config.scan.camera),
+                         config.slam.loop_closure.enabled && frame.estimate.mapped);
     if (tf)
       tf->update(frame.stamp_s, frame.estimate.T_map_base,
                  frame.has_odometry ? std::optional(frame.T_odom_base) : std::nullopt);

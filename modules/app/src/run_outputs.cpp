@@ -206,6 +206,7 @@ void OutputWriter::write_all(const RunRecord &all, const slam::PointMap &map, co
       std::count_if(run.frames.begin(), run.frames.end(), [](auto &f) { return f.keyframe; });
   summary["revisits"] =
       std::count_if(run.frames.begin(), run.frames.end(), [](auto &f) { return f.revisit; });
+  summary["mapped"] = std::count_if(run.frames.begin(), run.frames.end(), [](auto &f) { return f.mapped; });
   summary["loop_closures"] =
       std::count_if(run.frames.begin(), run.frames.end(), [](auto &f) { return f.loop_closed; });
   summary["map_points"] = map.points().size();

@@ -26,7 +26,8 @@ struct FrameRecord {
   bool integrated = false;
   bool localized = true;     ///< false: still searching for its pose on a saved map (no pose)
   bool keyframe = false;     ///< became a keyframe of the pose graph
-  bool revisit = false;      ///< revisited a keyframe: integrated, anchored to it, no new keyframe
+  bool revisit = false;      ///< revisited a keyframe: accepted, anchored to it, no new keyframe
+  bool mapped = false;       ///< its scan was integrated into the map (slam::FrameEstimate::mapped)
   bool loop_closed = false;  ///< a loop closure corrected the graph at this frame
   slam::Attempt attempt = slam::Attempt::kNone;
   double srel_percent = 0.0;

@@ -13,17 +13,17 @@ void TrajectoryGrid::seed(const GridImage &start) {
 }
 
 bool TrajectoryGrid::adds_to_last(const Eigen::Isometry2d &T_map_base) const {
-  if (scans_.empty()) return true;
-  const KeptScan &last = scans_.back();
-  const Eigen::Isometry2d step = last.T_map_base.inverse() * T_map_base;
+  if (!last_added_) return true;
+  const auto &[T_map_last, reach_m] = *last_added_;
+  const Eigen::Isometry2d step = T_map_last.inverse() * T_map_base;
   const double resolution_m = grid_.config().resolution_m;
   if (step.translation().norm() >= resolution_m) return true;
   const double turn_rad = std::abs(std::atan2(step.linear()(1, 0), step.linear()(0, 0)));
-  return turn_rad * last.reach_m >= resolution_m;
+  return turn_rad * reach_m >= resolution_m;
 }
 
 bool TrajectoryGrid::add_scan(int trajectory_index, const Eigen::Isometry2d &T_map_base,
-                              std::span<const Ray> rays) {
+                              std::span<const Ray> rays, bool keep) {
   if (!adds_to_last(T_map_base)) return false;
   KeptScan scan{trajectory_index, T_map_base, {}, 0.0};
   scan.rays.reserve(rays.size());
@@ -35,7 +35,8 @@ bool TrajectoryGrid::add_scan(int trajectory_index, const Eigen::Isometry2d &T_m
       if (std::isfinite(range_m)) scan.reach_m = std::max(scan.reach_m, range_m);
   }
   add_to_grid(scan, T_map_base);
-  scans_.push_back(std::move(scan));
+  last_added_ = {T_map_base, scan.reach_m};
+  if (keep) scans_.push_back(std::move(scan));
   return true;
 }
 

@@ -182,6 +182,7 @@ void read_loop_closure(YamlSection &section, slam::LoopClosureConfig &loops) {
   read_degrees(section, "edge_floor_yaw_deg", keyframes.edge_floor_yaw_rad);
   section.read("drift_per_m", keyframes.drift_per_m);
   read_degrees(section, "drift_yaw_deg_per_m", keyframes.drift_yaw_per_m);
+  section.read("keyframe_max_scans", keyframes.max_scans);
   section.read("min_path_gap_m", loops.min_path_gap_m);
   section.read("submap_path_m", loops.submap_path_m);
   section.read("max_candidate_distance_m", loops.max_candidate_distance_m);
@@ -237,6 +238,7 @@ void read_loop_closure(YamlSection &section, slam::LoopClosureConfig &loops) {
                                    {"min_weak_direction_share", loops.min_weak_direction_share}}) {
     if (!(value >= 0.0 && value <= 1.0)) section.fail(key, "must be in [0, 1]");
   }
+  if (keyframes.max_scans < 1) section.fail("keyframe_max_scans", "must be at least 1");
   if (loops.max_candidates < 1 || loops.max_candidates > 50)
     section.fail("max_candidates", "must be in 1..50");
   if (loops.max_sample_points < 10 || loops.max_sample_points > 10000)
@@ -281,6 +283,7 @@ void read_slam(YamlSection &section, slam::SlamConfig &slam) {
   section.read("prune_min_hits", slam.map.prune_min_hits);
   section.read("prune_min_age", slam.map.prune_min_age);
   section.read("localization_only", slam.localization_only);
+  section.read("map_min_step_m", slam.map_min_step_m);
   detail::read_section(section, "loop_closure",
                        [&slam](YamlSection &loops) { read_loop_closure(loops, slam.loop_closure); });
   if (!(slam.icp.overlap > 0.0 && slam.icp.overlap <= 1.0)) section.fail("overlap", "must be in (0, 1]");
@@ -311,6 +314,8 @@ void read_slam(YamlSection &section, slam::SlamConfig &slam) {
                                    {"prune_min_age", slam.map.prune_min_age}}) {
     if (value < 0) section.fail(key, "must be >= 0");
   }
+  if (!(slam.map_min_step_m >= 0.0 && std::isfinite(slam.map_min_step_m)))
+    section.fail("map_min_step_m", "must be a distance >= 0 (0: every accepted frame is integrated)");
   if (!(slam.min_inlier_share >= 0.0 && slam.min_inlier_share <= 1.0)) {
     section.fail("min_inlier_share", "must be in [0, 1]");
   }

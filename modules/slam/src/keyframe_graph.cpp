@@ -190,6 +190,11 @@ int KeyframeGraph::revisited(const Eigen::Isometry2d &T_map_base, double min_pat
 }
 
 void KeyframeGraph::add_revisit(int keyframe, const Points2 &scan_base, const Eigen::Isometry2d &T_map_base) {
+  add_revisit(keyframe, T_map_base);
+  store_scan(scan_base);
+}
+
+void KeyframeGraph::add_revisit(int keyframe, const Eigen::Isometry2d &T_map_base) {
   if (keyframe < 0 || keyframe > last())
     throw std::out_of_range("KeyframeGraph::add_revisit: keyframe " + std::to_string(keyframe) + " of " +
                             std::to_string(keyframes_.size()));
@@ -197,7 +202,22 @@ void KeyframeGraph::add_revisit(int keyframe, const Points2 &scan_base, const Ei
   last_frame_ = T_map_base;
   anchor_ = keyframe;
   frames_.push_back(anchor(T_map_base));
-  store_scan(scan_base);
+}
+
+bool KeyframeGraph::makes_keyframe(const Eigen::Isometry2d &T_map_base) const {
+  // After a resume that does not continue the saved tracking, the first integrated frame
+  // starts a keyframe of its own: its scan belongs to none of the saved keyframes.
+  if (keyframes_.empty() || !chained_) return true;
+  const Eigen::Isometry2d step =
+      keyframes_[static_cast<std::size_t>(anchor_)].T_map_keyframe.inverse() * T_map_base;
+  return step.translation().norm() >= config_.keyframe_distance_m ||
+         std::abs(yaw_rad_of(step)) >= config_.keyframe_angle_rad;
+}
+
+bool KeyframeGraph::has_room(const Eigen::Isometry2d &T_map_base, int revisit) const {
+  if (revisit < 0 && makes_keyframe(T_map_base)) return true;
+  const Keyframe &joined = keyframes_[static_cast<std::size_t>(revisit >= 0 ? revisit : last())];
+  return joined.scans_keyframe.size() < static_cast<std::size_t>(config_.max_scans);
 }
 
 void KeyframeGraph::mark_matched() {
@@ -220,15 +240,7 @@ bool KeyframeGraph::add_integrated(const Points2 &scan_base, const Eigen::Isomet
                                    const Eigen::Matrix3d &tracked_covariance) {
   if (!keyframes_.empty()) path_m_ += (T_map_base.translation() - last_frame_.translation()).norm();
   last_frame_ = T_map_base;
-  // After a resume that does not continue the saved tracking, the first integrated frame
-  // starts a keyframe of its own: its scan belongs to none of the saved keyframes.
-  bool is_keyframe = keyframes_.empty() || !chained_;
-  if (!is_keyframe) {
-    const Eigen::Isometry2d step =
-        keyframes_[static_cast<std::size_t>(anchor_)].T_map_keyframe.inverse() * T_map_base;
-    is_keyframe = step.translation().norm() >= config_.keyframe_distance_m ||
-                  std::abs(yaw_rad_of(step)) >= config_.keyframe_angle_rad;
-  }
+  const bool is_keyframe = makes_keyframe(T_map_base);
   if (is_keyframe) {
     const int node = graph_.add_node(T_map_base);
     if (node > 0 && chained_) {

@@ -191,6 +191,7 @@ void Slam::resume(std::vector<MapPoint> points, int integrations, const Eigen::I
   job_out_ = false;
   catch_up_job_.reset();
   tied_ = false;
+  last_mapped_.reset();
   ++generation_;
   map_ = PointMap(config_.map, std::move(points), integrations);
   started_ = true;
@@ -236,6 +237,7 @@ void Slam::set_pose(const Eigen::Isometry2d &T_map_base, const Eigen::Matrix3d &
   uncommitted_covariance_ = covariance;     // the operator's pose is as rough as they say
   since_keyframe_covariance_ = covariance;  // so is its relation to the last keyframe
   tied_ = false;                            // until a loop closure confirms the jump
+  last_mapped_.reset();                     // the first frame accepted at the new pose is integrated
   last_step_ = Eigen::Isometry2d::Identity();
   // The scans before the jump sit at the old poses: the whole map stands in for them.
   if (!map_.empty()) recent_scans_map_.assign(1, map_.index().points());
@@ -254,6 +256,8 @@ FrameEstimate Slam::seed_map(const Points2 &scan_base) {
   previous_ = {previous_.T_map_base, true, Attempt::kFirstFrame, {}, previous_.covariance};
   recent_scans_map_.assign(1, transformed(scan_base, previous_.T_map_base));
   map_.integrate(recent_scans_map_.front());
+  previous_.mapped = true;
+  last_mapped_ = previous_.T_map_base;
   if (config_.loop_closure.enabled) {
     previous_.keyframe = keyframes_.add_integrated(scan_base, previous_.T_map_base, previous_.covariance);
   } else {
@@ -350,6 +354,7 @@ void Slam::apply_loop_result(LoopResult result) {
   // corrected pose and registered against the corrected map.
   previous_.T_map_base = orthonormalized(T_corrected_tracked * previous_.T_map_base);
   anchor_T_map_base_ = orthonormalized(T_corrected_tracked * anchor_T_map_base_);
+  if (last_mapped_) last_mapped_ = orthonormalized(T_corrected_tracked * *last_mapped_);
   for (Points2 &scan : recent_scans_map_) scan = transformed(scan, T_corrected_tracked);
 }
 
@@ -407,24 +412,33 @@ FrameEstimate Slam::process(const Points2 &scan_base, const std::optional<Eigen:
     // the scan fits anywhere, and only odometry tells where.
     const bool odometry_gap = config_.use_odometry && !T_odom_base;
     if (!config_.localization_only && !odometry_gap) {
-      map_.integrate(transformed(scan_base, estimate.T_map_base));
       const LoopClosureConfig &loops = config_.loop_closure;
       const int revisited = loops.enabled && loops.reuse_keyframes && tied_
                                 ? keyframes_.revisited(estimate.T_map_base, loops.min_path_gap_m)
                                 : -1;
+      estimate.mapped =
+          (!last_mapped_ || (estimate.T_map_base.translation() - last_mapped_->translation()).norm() >=
+                                config_.map_min_step_m) &&
+          (!loops.enabled || keyframes_.has_room(estimate.T_map_base, revisited));
+      if (estimate.mapped) map_.integrate(transformed(scan_base, estimate.T_map_base));
       if (revisited >= 0) {
         // A mapped place: the frame follows the keyframe it revisits, and its relation to
         // that keyframe is this registration's (the map there holds the keyframe's scans).
         // Its scan still refines the map (fused points average over every visit: on six
         // laps of the synthetic L-room, seeds 1-6, the first lap's map alone left the later
-        // laps' worst frame 40 mm off on average, the refined map 29 mm).
-        keyframes_.add_revisit(revisited, scan_base, estimate.T_map_base);
+        // laps' worst frame 40 mm off on average, the refined map 29 mm), up to max_scans.
+        if (estimate.mapped) {
+          keyframes_.add_revisit(revisited, scan_base, estimate.T_map_base);
+        } else {
+          keyframes_.add_revisit(revisited, estimate.T_map_base);
+        }
         since_keyframe_covariance_ = term;
         estimate.revisit = in_graph = true;
-      } else if (loops.enabled) {
+      } else if (loops.enabled && estimate.mapped) {
         estimate.T_map_base = update_graph(scan_base, estimate);
         in_graph = true;
       }
+      if (estimate.mapped) last_mapped_ = estimate.T_map_base;
     }
   } else {
     relaxation_percent_ += config_.srel_relax_percent;

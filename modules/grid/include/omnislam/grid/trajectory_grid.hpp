@@ -3,6 +3,7 @@
 #include <Eigen/Geometry>
 #include <optional>
 #include <span>
+#include <utility>
 #include <vector>
 
 #include "omnislam/grid/occupancy_grid.hpp"
@@ -11,10 +12,12 @@
 /// An occupancy grid that follows a corrected trajectory (issue 14: "rebuilt when the map is
 /// corrected"). It keeps the scans it was built from, each with the index of its frame in
 /// the trajectory, so that after a loop closure the grid is built again from the corrected
-/// poses. A scan is kept (and added) only when it can change what the grid says: the robot
-/// moved by a cell since the last kept scan, or turned by the angle that moves the end of
-/// that scan's longest ray by a cell. A robot standing still adds nothing, so memory grows
-/// with the ground covered, about 4 kB per kept scan of 360 rays. Not thread-safe.
+/// poses. A scan is added only when it can change what the grid says: the robot moved by a
+/// cell since the last added scan, or turned by the angle that moves the end of that scan's
+/// longest ray by a cell. A robot standing still adds nothing. An added scan is kept for
+/// the rebuilds when its caller says so (the service keeps those the SLAM keeps, so the
+/// grid's memory is bounded as the map's is), about 4 kB per kept scan of 360 rays. Not
+/// thread-safe.
 
 namespace omnislam::grid {
 
@@ -26,11 +29,14 @@ class TrajectoryGrid {
   void seed(const GridImage &start);
 
   /// Adds the scan of frame `trajectory_index` (-1: a frame whose pose no correction will
-  /// move; it keeps `T_map_base`) taken at `T_map_base`. Returns whether it was kept.
-  bool add_scan(int trajectory_index, const Eigen::Isometry2d &T_map_base, std::span<const Ray> rays);
+  /// move; it keeps `T_map_base`) taken at `T_map_base`, and with `keep` keeps it for the
+  /// rebuilds. Returns whether it was added.
+  bool add_scan(int trajectory_index, const Eigen::Isometry2d &T_map_base, std::span<const Ray> rays,
+                bool keep = true);
 
   /// Builds the grid again: the seed, then every kept scan at `trajectory[index]` (at the
-  /// pose it was added with where the index is -1 or beyond the trajectory).
+  /// pose it was added with where the index is -1 or beyond the trajectory). Scans added
+  /// but not kept are gone from it.
   void rebuild(std::span<const Eigen::Isometry2d> trajectory);
 
   [[nodiscard]] GridImage image() const { return grid_.image(); }
@@ -53,6 +59,8 @@ class TrajectoryGrid {
   OccupancyGrid grid_;
   std::optional<GridImage> seed_;
   std::vector<KeptScan> scans_;
+  /// The last added scan's pose and longest ray (what the next one must move by a cell from).
+  std::optional<std::pair<Eigen::Isometry2d, double>> last_added_;
 };
 
 }  // namespace omnislam::grid

@@ -36,6 +36,13 @@ struct KeyframeConfig {
   /// loop search's window (LoopClosureConfig), not the edges.
   double drift_per_m = 0.03;        ///< position, m per m travelled
   double drift_yaw_per_m = 0.0087;  ///< heading, rad per m travelled (0.5 deg/m)
+  /// The scans a keyframe holds at most (its own, the frames that join it, revisits): a
+  /// frame that would join a full keyframe is tracked but not integrated, so a place driven
+  /// through again and again, or a robot standing still, costs bounded memory and a bounded
+  /// share of every map rebuild. 16 views of a place leave a fused map point a quarter of
+  /// one view's noise; what the front-end gets wrong the same way every time (a few mm,
+  /// README "Front-end on real floors") more views would not remove.
+  int max_scans = 16;
 };
 
 struct Keyframe {
@@ -116,6 +123,12 @@ class KeyframeGraph {
   /// Records a frame that was not integrated (only its pose, relative to the keyframe the
   /// frames are anchored to: the last one, or the one revisited).
   void add_pose(const Eigen::Isometry2d &T_map_base);
+  /// Whether a frame integrated at `T_map_base` would become a keyframe (add_integrated).
+  [[nodiscard]] bool makes_keyframe(const Eigen::Isometry2d &T_map_base) const;
+  /// Whether a frame at `T_map_base` has room to be integrated: it would make a keyframe, or
+  /// the keyframe it would join (`revisit` when >= 0, else the last) holds fewer than
+  /// max_scans scans.
+  [[nodiscard]] bool has_room(const Eigen::Isometry2d &T_map_base, int revisit) const;
 
   /// The keyframe a frame at `T_map_base` revisits: the nearest within keyframe_distance_m
   /// that lies at least `min_path_gap_m` back along the path (a place mapped before, not the
@@ -127,6 +140,9 @@ class KeyframeGraph {
   /// stored there, no new keyframe. The next keyframe is joined to `keyframe` by its
   /// sequential edge.
   void add_revisit(int keyframe, const Points2 &scan_base, const Eigen::Isometry2d &T_map_base);
+  /// The same for a frame that is not integrated (its keyframe is full): only its pose,
+  /// anchored to `keyframe`.
+  void add_revisit(int keyframe, const Eigen::Isometry2d &T_map_base);
 
   /// Adds a loop edge: keyframe `current` seen at T_candidate_current from `candidate`.
   void add_loop(int candidate, int current, const Eigen::Isometry2d &T_candidate_current,

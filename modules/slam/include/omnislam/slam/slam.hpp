@@ -66,6 +66,13 @@ struct SlamConfig {
   /// Localization only: frames are registered against the (restored) map as usual, but
   /// nothing is ever integrated, so the map stays exactly as it was loaded.
   bool localization_only = false;
+  /// An accepted frame is integrated into the map only when it lies at least this far from
+  /// the last integrated one: nearer, an omnidirectional camera sees the same points from
+  /// the same place (turning on the spot shows it nothing new), so the frame would add
+  /// weight, not information. The map's fusion radius (0.05 m): at 30 Hz a robot standing
+  /// still, or creeping, integrates nothing, one driving at 0.5 m/s every third frame. 0:
+  /// every accepted frame (the thesis; its images lie 0.15-1 m apart).
+  double map_min_step_m = 0.05;
   /// Keyframes, a pose graph over them and loop closure (beyond the thesis). When a loop
   /// closes, the keyframe poses are optimised, the map is rebuilt from them and the current
   /// pose follows the correction.
@@ -85,14 +92,19 @@ enum class Attempt {
 
 struct FrameEstimate {
   Eigen::Isometry2d T_map_base = Eigen::Isometry2d::Identity();
-  bool integrated = false;  ///< a registration was accepted (and, unless localization_only, integrated)
+  bool integrated = false;  ///< a registration was accepted (tracked; its scan integrated when `mapped`)
   Attempt attempt = Attempt::kNone;
   TrimmedIcpResult registration;                         ///< the accepted one, or the last tried
   Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();  ///< (x, y, yaw) in the map frame
   bool keyframe = false;                                 ///< the frame became a keyframe of the pose graph
-  /// The frame revisited a keyframe (LoopClosureConfig::reuse_keyframes): integrated and
-  /// anchored to that keyframe, not a keyframe itself.
+  /// The frame revisited a keyframe (LoopClosureConfig::reuse_keyframes): accepted and
+  /// anchored to that keyframe (its scan stored there when `mapped`), not a keyframe itself.
   bool revisit = false;
+  /// The scan was integrated into the map (and stored in the keyframe graph with loop
+  /// closure on). An accepted frame is not: localization only, in an odometry gap, within
+  /// map_min_step_m of the last integrated frame, or joining a full keyframe
+  /// (KeyframeConfig::max_scans).
+  bool mapped = false;
   /// A loop closure corrected the graph (and T_map_base) at this frame: its own keyframe's
   /// (inline loop closure) or a job's result applied just before it (background).
   bool loop_closed = false;
@@ -260,6 +272,9 @@ class Slam {
   /// the current pose relative to that keyframe, the next sequential edge's covariance.
   Eigen::Matrix3d since_keyframe_covariance_ = Eigen::Matrix3d::Zero();
   bool predicted_by_odometry_ = false;  ///< the current frame's prediction came from odometry
+  /// The last integrated frame's pose (moved by corrections as the tracking is), or none:
+  /// the next accepted frame is integrated (map_min_step_m).
+  std::optional<Eigen::Isometry2d> last_mapped_;
   bool previous_failed_ = false;
 };
 
