@@ -39,21 +39,15 @@ namespace {
 struct Data {
   std::vector<cv::Mat> images;
   std::vector<Eigen::Isometry2d> odometry;
-  std::vector<Eigen::Isometry2d> groundtruth;  ///< empty when the dataset has none
-  /// What moves one loop's odometry onto the next's: the odometry accumulated over a loop,
-  /// then the true step from the last pose back to the first (identity without ground truth).
-  Eigen::Isometry2d seam = Eigen::Isometry2d::Identity();
+  std::vector<Eigen::Isometry2d> groundtruth;              ///< empty when the dataset has none
+  Eigen::Isometry2d seam = Eigen::Isometry2d::Identity();  ///< io::loop_seam
   stereo::ScanConfig scan;
 
-  /// Odometry of frame `f` of the dataset looped: the robot drives from the last pose back
-  /// to the first (that step's odometry is the true motion) and round again, so the
-  /// odometry stays continuous, as a robot's does on a long stay. Without ground truth the
-  /// odometry jumps back to its start (a robot carried back to where it began).
+  /// Odometry of frame `f` of the dataset looped (io::looped_odometry: the robot drives
+  /// from the last pose back to the first and round again; without ground truth the
+  /// odometry jumps back to its start).
   [[nodiscard]] Eigen::Isometry2d looped_odometry(std::size_t f) const {
-    const std::size_t n = odometry.size();
-    Eigen::Isometry2d offset = Eigen::Isometry2d::Identity();
-    for (std::size_t loop = 0; loop < f / n; ++loop) offset = offset * seam;
-    return offset * odometry[f % n];
+    return io::looped_odometry(odometry, seam, f);
   }
 };
 
@@ -64,10 +58,7 @@ Data load(const std::filesystem::path &dir) {
   data.scan.camera_height_m = info.camera_height_m;
   data.odometry = io::to_isometries(io::read_tum_file(info.odometry));
   if (!info.groundtruth.empty()) data.groundtruth = io::to_isometries(io::read_tum_file(info.groundtruth));
-  const std::size_t n = data.odometry.size();
-  if (n > 0 && data.groundtruth.size() == n)
-    data.seam = data.odometry[n - 1] * data.groundtruth[n - 1].inverse() * data.groundtruth[0] *
-                data.odometry[0].inverse();
+  data.seam = io::loop_seam(data.odometry, data.groundtruth);
   for (int i = 1; i <= info.frames; ++i)
     data.images.push_back(io::read_camera_image(info.image(i), data.scan.camera));
   return data;

@@ -1,4 +1,5 @@
 #include <catch2/catch.hpp>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <numbers>
@@ -8,6 +9,7 @@
 #include "omnislam/io/dataset.hpp"
 #include "omnislam/io/ground_truth_files.hpp"
 #include "omnislam/io/image_file.hpp"
+#include "omnislam/io/poses.hpp"
 
 namespace fs = std::filesystem;
 
@@ -106,4 +108,34 @@ TEST_CASE("thesis odometry.txt of a rendered dataset matches its odometry.tum", 
     CHECK(thesis[i].x_m == Approx(tum[i].x_m - tum[0].x_m).margin(1e-5));
     CHECK(thesis[i].y_m == Approx(tum[i].y_m - tum[0].y_m).margin(1e-5));
   }
+}
+
+TEST_CASE("looped dataset: the odometry continues across passes through the true step back to the start",
+          "[io][dataset]") {
+  // Truth: a square tour that ends 0.3 m short of its start; odometry: the truth with a
+  // drift that grows along it, in a frame of its own.
+  std::vector<Eigen::Isometry2d> truth, odometry;
+  const Eigen::Isometry2d odom_frame = omnislam::slam::planar_pose(5.0, -2.0, 0.7);
+  for (int i = 0; i < 12; ++i) {
+    const double s = i * 0.25;
+    truth.push_back(omnislam::slam::planar_pose(std::cos(s) * s, std::sin(s), 0.3 * s));
+    odometry.push_back(odom_frame * omnislam::slam::planar_pose(0.02 * i, -0.01 * i, 0.01 * i) *
+                       truth.back());
+  }
+  const Eigen::Isometry2d seam = omnislam::io::loop_seam(odometry, truth);
+  const std::size_t n = truth.size();
+  for (std::size_t pass = 1; pass < 4; ++pass) {
+    // Within a pass the odometry's steps are the dataset's ...
+    const Eigen::Isometry2d step = omnislam::io::looped_odometry(odometry, seam, pass * n + 4).inverse() *
+                                   omnislam::io::looped_odometry(odometry, seam, pass * n + 5);
+    CHECK(step.isApprox(odometry[4].inverse() * odometry[5], 1e-9));
+    // ... and across the seam the true step from the last pose to the first.
+    const Eigen::Isometry2d across = omnislam::io::looped_odometry(odometry, seam, pass * n - 1).inverse() *
+                                     omnislam::io::looped_odometry(odometry, seam, pass * n);
+    CHECK(across.isApprox(truth[n - 1].inverse() * truth[0], 1e-9));
+  }
+  CHECK(omnislam::io::looped_odometry(odometry, seam, 3).isApprox(odometry[3], 1e-12));
+  // Without ground truth for every frame: the odometry jumps back to its start.
+  CHECK(omnislam::io::loop_seam(odometry, {}).isApprox(Eigen::Isometry2d::Identity()));
+  CHECK(omnislam::io::looped_odometry(odometry, Eigen::Isometry2d::Identity(), n + 2).isApprox(odometry[2]));
 }

@@ -6,6 +6,7 @@
 #include <utility>
 
 #include "omnislam/io/image_file.hpp"
+#include "omnislam/io/poses.hpp"
 
 namespace omnislam::app {
 
@@ -20,7 +21,7 @@ pipeline::FrameSource dataset_source(const io::DatasetInfo &info, std::vector<Ei
     const int frame_number = index % frames + 1;
     auto frame = std::make_unique<pipeline::Frame>();
     frame->stamp_s = index / info.rate_hz;
-    frame->T_odom_base = odometry[static_cast<std::size_t>(frame_number - 1)];
+    frame->T_odom_base = io::looped_odometry(odometry, options.seam, static_cast<std::size_t>(index));
     frame->has_odometry = true;
     try {
       frame->image = io::read_camera_image(info.image(frame_number), camera);

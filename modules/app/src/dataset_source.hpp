@@ -16,6 +16,9 @@ namespace omnislam::app {
 
 struct DatasetSourceOptions {
   int loops = 1;  ///< play the dataset this many times (stamps keep increasing)
+  /// What moves one pass's odometry onto the next's (io::loop_seam): the identity jumps
+  /// back to the first frame's odometry.
+  Eigen::Isometry2d seam = Eigen::Isometry2d::Identity();
   /// Frames stamped at or before this are passed over unread (a service resuming the
   /// dataset from a snapshot taken at this time).
   double after_s = -std::numeric_limits<double>::infinity();
@@ -28,7 +31,8 @@ struct DatasetSourceOptions {
 };
 
 /// Frame i (1-based) of the dataset: stamp (i - 1) / rate_hz, odometry[i - 1] (odometry
-/// poses of the dataset's frames, any fixed odom frame), the image read and checked
+/// poses of the dataset's frames, any fixed odom frame; on later passes moved by
+/// options.seam once per pass), the image read and checked
 /// against `camera`, then degraded when options.degrader is set.
 [[nodiscard]] pipeline::FrameSource dataset_source(const io::DatasetInfo &info,
                                                    std::vector<Eigen::Isometry2d> odometry,

@@ -41,4 +41,28 @@ inline std::vector<Eigen::Isometry2d> relative_to_first(const std::vector<Eigen:
   return out;
 }
 
+/// What moves one pass's odometry onto the next's when a dataset is driven round again
+/// (omnislamd's input.loops, the benchmarks): the odometry accumulated over a pass, then the
+/// true step from the last pose back to the first, so the odometry stays continuous, as a
+/// robot's does when it drives round a room for hours. Without ground truth for every
+/// frame, the identity: the odometry jumps back to its start (a robot carried back to where
+/// it began, which SLAM sees as a kidnapping, the prediction off by the pass's drift).
+inline Eigen::Isometry2d loop_seam(const std::vector<Eigen::Isometry2d> &odometry,
+                                   const std::vector<Eigen::Isometry2d> &groundtruth) {
+  const std::size_t n = odometry.size();
+  if (n == 0 || groundtruth.size() != n) return Eigen::Isometry2d::Identity();
+  return slam::orthonormalized(odometry[n - 1] * groundtruth[n - 1].inverse() * groundtruth[0] *
+                               odometry[0].inverse());
+}
+
+/// The odometry of frame `f` (0-based) of a dataset's passes joined by `seam` (loop_seam):
+/// seam^(f / n) * odometry[f % n].
+inline Eigen::Isometry2d looped_odometry(const std::vector<Eigen::Isometry2d> &odometry,
+                                         const Eigen::Isometry2d &seam, std::size_t f) {
+  const std::size_t n = odometry.size();
+  Eigen::Isometry2d offset = Eigen::Isometry2d::Identity();
+  for (std::size_t pass = 0; pass < f / n; ++pass) offset = slam::orthonormalized(offset * seam);
+  return offset * odometry[f % n];
+}
+
 }  // namespace omnislam::io

@@ -29,7 +29,10 @@ struct InputConfig {
   /// Frames per second to feed the pipeline: < 0 the dataset's own rate (or the
   /// camera's), 0 as fast as possible, > 0 this rate.
   double rate_hz = -1.0;
-  int loops = 1;  ///< play a dataset or directory this many times
+  /// Play a dataset or directory this many times. A dataset's odometry (with its ground
+  /// truth) continues across passes as if the robot drove from the last pose back to the
+  /// first (io::loop_seam); without ground truth it jumps back.
+  int loops = 1;
   /// Odometry source, matched to frames by timestamp: dataset (its odometry.tum), dds
   /// (nav_msgs Odometry on odometry_topic) or none.
   std::string odometry = "dataset";
