@@ -36,9 +36,10 @@ struct LoopClosureConfig {
   /// ends can correct it) is anchored to that keyframe and its scan stored there: no new
   /// keyframe. The pose graph, and with it every later loop search, solve and adoption
   /// of a solved graph, then grows with the area explored, not with the laps driven (and
-  /// the stored scans with it: each keyframe holds at most KeyframeConfig::max_scans). Leaving the mapped
-  /// places makes a keyframe again (joined to the one revisited last), and the tie lasts until then. false:
-  /// every keyframe_distance_m of travel makes a keyframe, wherever it is.
+  /// the stored scans with it: each keyframe holds at most KeyframeConfig::max_scans).
+  /// Leaving the mapped places makes a keyframe again (joined to the one revisited last),
+  /// and the tie lasts until then. false: every keyframe_distance_m of travel makes a
+  /// keyframe, wherever it is.
   bool reuse_keyframes = true;
   /// A candidate lies at least this far back along the path (closer ones are already in
   /// the local map the tracking registers against).
