@@ -280,6 +280,18 @@ TEST_CASE("config: slam.map_min_step_m, 0 for the thesis", "[io][config]") {
                     Catch::Contains("step-bad.yaml:2") && Catch::Contains("map_min_step_m"));
 }
 
+TEST_CASE("config: slam.lost_after_frames, 0 (never lost) for the thesis", "[io][config]") {
+  CHECK(omnislam::io::Config{}.slam.lost_after_frames == 3);
+  CHECK(omnislam::io::load_config(OMNISLAM_SOURCE_DIR "/deploy/thesis-2008.yaml").slam.lost_after_frames ==
+        0);
+  CHECK(omnislam::io::load_config(OMNISLAM_SOURCE_DIR "/deploy/omnislamd.yaml").slam.lost_after_frames == 3);
+  CHECK(omnislam::io::load_config(write_file("lost.yaml", "slam:\n  lost_after_frames: 5\n"))
+            .slam.lost_after_frames == 5);
+  CHECK_THROWS_WITH(
+      omnislam::io::load_config(write_file("lost-bad.yaml", "slam:\n  lost_after_frames: -1\n")),
+      Catch::Contains("lost-bad.yaml:2") && Catch::Contains("lost_after_frames"));
+}
+
 TEST_CASE("config: the installed defaults (deploy/*.yaml) load", "[io][config]") {
   const fs::path deploy = fs::path(OMNISLAM_SOURCE_DIR) / "deploy";
   const omnislam::io::Config service = omnislam::io::load_config(deploy / "omnislamd.yaml");

@@ -16,6 +16,8 @@ namespace omnislam::app {
   record.skipped = frame.skipped();
   record.integrated = frame.estimate.integrated;
   record.localized = frame.localized;
+  record.lost = frame.estimate.lost;
+  record.relocalized = frame.estimate.relocalized;
   record.keyframe = frame.estimate.keyframe;
   record.revisit = frame.estimate.revisit;
   record.mapped = frame.estimate.mapped;

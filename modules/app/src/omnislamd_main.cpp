@@ -165,6 +165,8 @@ int run_service(const std::string &config_file) {
   RunRecord run;
   bool posed = !search_start;  // a frame has had a pose (set by the publish thread; read after join)
   std::uint64_t not_localized = 0;
+  std::optional<std::uint64_t> lost_at;  // the frame the tracking was lost at, until found again
+  std::uint64_t lost_frames = 0;
   // rt/map, snapshots, and map.yaml + map.pgm in output_dir; rebuilt when a loop closure
   // corrects the poses it was built with.
   grid::TrajectoryGrid occupancy;
@@ -202,9 +204,32 @@ int run_service(const std::string &config_file) {
     }
     if (frame.dropped_before > 0)
       spdlog::debug("{} frames dropped before frame {}", frame.dropped_before, frame.sequence);
+    if (frame.estimate.lost) {  // no pose published until the robot is found on the map again
+      if (!lost_at) {
+        lost_at = frame.sequence;
+        const std::string message = fmt::format(
+            "tracking lost at frame {}: the scans do not fit the map where odometry puts them "
+            "(slam.lost_after_frames); searching the whole map, nothing published or mapped until found",
+            frame.sequence);
+        spdlog::warn("{}", message);
+        if (publisher)
+          publisher->status({system_time_s(), dds::ServiceState::kLocalizing, frame.sequence, 0, 0, message});
+      }
+      ++lost_frames;
+      return;
+    }
     if (!frame.localized) {  // no pose yet: nothing to publish, grid or save
       ++not_localized;
       return;
+    }
+    if (lost_at) {
+      spdlog::info("found again at frame {} (lost since frame {}): x {:.3f} m, y {:.3f} m, yaw {:.1f} deg",
+                   frame.sequence, *lost_at, frame.estimate.T_map_base.translation().x(),
+                   frame.estimate.T_map_base.translation().y(),
+                   slam::yaw_rad_of(frame.estimate.T_map_base) * 180.0 / std::numbers::pi);
+      lost_at.reset();
+      if (publisher)
+        publisher->status({system_time_s(), dds::ServiceState::kRunning, frame.sequence, 0, 0, ""});
     }
     if (!posed) {
       posed = true;
@@ -220,7 +245,7 @@ int run_service(const std::string &config_file) {
     if (gridded && frame.trajectory) occupancy.rebuild(*frame.trajectory);
     // Kept for the rebuilds after loop closures only where the SLAM keeps the frame's scan
     // for its own (bounded per keyframe): a place driven through again and again grows neither.
-    if (gridded && !frame.skipped())
+    if (gridded && !frame.skipped() && !frame.estimate.unfit)
       occupancy.add_scan(frame.estimate.trajectory_index, frame.estimate.T_map_base,
                          scan_rays(frame.scan, config.scan.camera),
                          config.slam.loop_closure.enabled && frame.estimate.mapped);
@@ -345,6 +370,10 @@ int run_service(const std::string &config_file) {
     spdlog::info("{} frames before the pose was found on the saved map", not_localized);
   if (search_start && !posed)
     spdlog::warn("{} frames and no pose found on the saved map (it is kept unchanged)", not_localized);
+  if (lost_frames > 0) {
+    spdlog::info("{} frames without a pose while the tracking was lost{}", lost_frames,
+                 lost_at ? fmt::format(" (lost since frame {} at the end)", *lost_at) : std::string());
+  }
   if (!pipeline.error().empty()) {
     spdlog::error("{}", pipeline.error());
     return 1;

@@ -90,7 +90,7 @@ void run_replay(const ReplayOptions &options, std::optional<std::uint64_t> degra
   grid::TrajectoryGrid occupancy;
   sinks.frame = [&](const pipeline::Frame &frame) {
     run.frames.push_back(frame_record(frame));
-    if (!frame.skipped() && frame.localized)
+    if (!frame.skipped() && frame.localized && !frame.estimate.lost && !frame.estimate.unfit)
       occupancy.add_scan(frame.estimate.trajectory_index, frame.estimate.T_map_base,
                          scan_rays(frame.scan, config.scan.camera));
     if (frame.estimate.integrated && frame.map)

@@ -171,6 +171,7 @@ void OutputWriter::write_all(const RunRecord &all, const slam::PointMap &map, co
                              const std::vector<Eigen::Isometry2d> &optimised) const {
   // Frames still searching for their pose on a saved map have none: the pose files, the
   // covariance and the errors are of the frames that have one (all of them, unless localizing).
+  // A lost frame has its dead-reckoned pose there, as any frame not integrated (summary: lost).
   const RunRecord run = with_pose(all);
   std::vector<io::StampedPose> trajectory, trajectory_online;
   std::vector<Eigen::Isometry2d> online;
@@ -202,6 +203,20 @@ void OutputWriter::write_all(const RunRecord &all, const slam::PointMap &map, co
   summary["not_integrated"] = static_cast<long>(all.frames.size()) - integrated;
   summary["skipped"] = std::count_if(all.frames.begin(), all.frames.end(), [](auto &f) { return f.skipped; });
   if (all.localizing) summary["not_localized"] = all.frames.size() - run.frames.size();
+  summary["lost"] = std::count_if(all.frames.begin(), all.frames.end(), [](auto &f) { return f.lost; });
+  // Each stretch of lost frames as [first, last] (1-based frame numbers).
+  nlohmann::json spans = nlohmann::json::array();
+  for (std::size_t i = 0; i < all.frames.size(); ++i) {
+    if (!all.frames[i].lost) continue;
+    if (i > 0 && all.frames[i - 1].lost) {
+      spans.back()[1] = i + 1;
+    } else {
+      spans.push_back({i + 1, i + 1});
+    }
+  }
+  summary["lost_spans"] = spans;
+  summary["relocalized"] =
+      std::count_if(all.frames.begin(), all.frames.end(), [](auto &f) { return f.relocalized; });
   summary["keyframes"] =
       std::count_if(run.frames.begin(), run.frames.end(), [](auto &f) { return f.keyframe; });
   summary["revisits"] =

@@ -25,6 +25,8 @@ struct FrameRecord {
   bool skipped = false;  ///< the image could not be used
   bool integrated = false;
   bool localized = true;     ///< false: still searching for its pose on a saved map (no pose)
+  bool lost = false;         ///< the tracking was lost: a dead-reckoned pose (slam::FrameEstimate::lost)
+  bool relocalized = false;  ///< a lost robot was found again at this frame
   bool keyframe = false;     ///< became a keyframe of the pose graph
   bool revisit = false;      ///< revisited a keyframe: accepted, anchored to it, no new keyframe
   bool mapped = false;       ///< its scan was integrated into the map (slam::FrameEstimate::mapped)

@@ -284,6 +284,7 @@ void read_slam(YamlSection &section, slam::SlamConfig &slam) {
   section.read("prune_min_age", slam.map.prune_min_age);
   section.read("localization_only", slam.localization_only);
   section.read("map_min_step_m", slam.map_min_step_m);
+  section.read("lost_after_frames", slam.lost_after_frames);
   detail::read_section(section, "loop_closure",
                        [&slam](YamlSection &loops) { read_loop_closure(loops, slam.loop_closure); });
   if (!(slam.icp.overlap > 0.0 && slam.icp.overlap <= 1.0)) section.fail("overlap", "must be in (0, 1]");
@@ -311,7 +312,8 @@ void read_slam(YamlSection &section, slam::SlamConfig &slam) {
                                    {"noise_min_neighbors", slam.map.noise_min_neighbors},
                                    {"prune_every", slam.map.prune_every},
                                    {"prune_min_hits", slam.map.prune_min_hits},
-                                   {"prune_min_age", slam.map.prune_min_age}}) {
+                                   {"prune_min_age", slam.map.prune_min_age},
+                                   {"lost_after_frames", slam.lost_after_frames}}) {
     if (value < 0) section.fail(key, "must be >= 0");
   }
   if (!(slam.map_min_step_m >= 0.0 && std::isfinite(slam.map_min_step_m)))

@@ -3,6 +3,7 @@
 #include <Eigen/Cholesky>
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <memory>
 #include <stdexcept>
 #include <string>
@@ -181,6 +182,21 @@ int KeyframeGraph::revisited(const Eigen::Isometry2d &T_map_base, double min_pat
     if (path_m_ - keyframe.path_m < min_path_gap_m) break;  // path_m grows with k
     if (!matched_[static_cast<std::size_t>(k)]) continue;
     const double distance_m = (keyframe.T_map_keyframe.translation() - T_map_base.translation()).norm();
+    if (distance_m < nearest_m) {
+      nearest = k;
+      nearest_m = distance_m;
+    }
+  }
+  return nearest;
+}
+
+int KeyframeGraph::nearest(const Eigen::Isometry2d &T_map_base) const {
+  int nearest = -1;
+  double nearest_m = std::numeric_limits<double>::infinity();
+  for (int k = 0; k <= last(); ++k) {
+    const double distance_m =
+        (keyframes_[static_cast<std::size_t>(k)].T_map_keyframe.translation() - T_map_base.translation())
+            .norm();
     if (distance_m < nearest_m) {
       nearest = k;
       nearest_m = distance_m;

@@ -1,5 +1,6 @@
 #include "omnislam/slam/slam.hpp"
 #include "omnislam/slam/planar_pose.hpp"
+#include "omnislam/slam/ray_agreement.hpp"
 
 #include <cmath>
 #include <limits>
@@ -205,6 +206,8 @@ void Slam::resume(std::vector<MapPoint> points, int integrations, const Eigen::I
   recent_scans_map_.assign(1, map_.index().points());
   relaxation_percent_ = 0.0;
   previous_failed_ = false;
+  misfits_ = 0;
+  relocalizer_.reset();
 }
 
 KeyframeGraph Slam::resumed_graph(const ResumedGraph &graph, int integrations) const {
@@ -243,6 +246,8 @@ void Slam::set_pose(const Eigen::Isometry2d &T_map_base, const Eigen::Matrix3d &
   if (!map_.empty()) recent_scans_map_.assign(1, map_.index().points());
   relaxation_percent_ = 0.0;
   previous_failed_ = false;
+  misfits_ = 0;  // the operator says where the robot is: not lost
+  relocalizer_.reset();
 }
 
 void Slam::set_anchor(const Eigen::Isometry2d &T_odom_base, const Eigen::Isometry2d &T_map_base) {
@@ -350,6 +355,7 @@ void Slam::apply_loop_result(LoopResult result) {
   job_out_ = false;
   const Eigen::Isometry2d T_corrected_tracked = take_result(std::move(result));
   if (!closed_since_frame_) return;
+  if (relocalizer_ && rebuilt_since_frame_) search_map();  // the search follows the corrected map
   // The tracking state follows the correction: the next frame is predicted from the
   // corrected pose and registered against the corrected map.
   previous_.T_map_base = orthonormalized(T_corrected_tracked * previous_.T_map_base);
@@ -385,6 +391,8 @@ FrameEstimate Slam::process(const Points2 &scan_base, const std::optional<Eigen:
   // reason to reject a correction.
   predicted_by_odometry_ = config_.use_odometry && T_odom_base.has_value();
 
+  if (relocalizer_) return search_lost(scan_base, T_odom_base, predicted, step);
+
   FrameEstimate estimate;
   estimate.T_map_base = predicted;
   if (static_cast<int>(scan_base.size()) >= config_.min_scan_points)
@@ -399,6 +407,10 @@ FrameEstimate Slam::process(const Points2 &scan_base, const std::optional<Eigen:
       estimate.T_map_base = refined.T_model_sample;
   }
 
+  // A scan that contradicts the map where it is placed is not added to it, even when it
+  // fits the previous scan: after a kidnapping both scans sit at the wrong pose.
+  const bool misfit = count_misfit(scan_base, estimate);
+  estimate.unfit = misfit;
   bool in_graph = false;  // recorded as an integrated frame of the keyframe graph
   uncommitted_covariance_ = estimate.integrated ? Eigen::Matrix3d::Zero() : prediction_covariance_;
   // The tracking's uncertainty of this pose relative to the last keyframe: the same terms
@@ -411,7 +423,7 @@ FrameEstimate Slam::process(const Points2 &scan_base, const std::optional<Eigen:
     // A frame without odometry is registered but never changes the map: along a corridor
     // the scan fits anywhere, and only odometry tells where.
     const bool odometry_gap = config_.use_odometry && !T_odom_base;
-    if (!config_.localization_only && !odometry_gap) {
+    if (!config_.localization_only && !odometry_gap && !misfit) {
       const LoopClosureConfig &loops = config_.loop_closure;
       const int revisited = loops.enabled && loops.reuse_keyframes && tied_
                                 ? keyframes_.revisited(estimate.T_map_base, loops.min_path_gap_m)
@@ -443,7 +455,93 @@ FrameEstimate Slam::process(const Points2 &scan_base, const std::optional<Eigen:
   } else {
     relaxation_percent_ += config_.srel_relax_percent;
   }
+  if (config_.lost_after_frames > 0 && misfits_ >= config_.lost_after_frames) {
+    walk_before_lost_ = walk_covariance_;
+    walk_dof_before_lost_ = walk_dof_;
+    search_map();
+    estimate.lost = true;
+  }
   estimate.covariance = published_covariance(estimate, term);
+  return finish_frame(estimate, scan_base, T_odom_base, in_graph);
+}
+
+bool Slam::count_misfit(const Points2 &scan_base, const FrameEstimate &estimate) {
+  if (config_.lost_after_frames <= 0 || !config_.use_odometry || config_.target != RegistrationTarget::kMap)
+    return false;
+  if (estimate.integrated && estimate.attempt == Attempt::kMap) {
+    misfits_ = 0;
+    return false;
+  }
+  // No judgement without a scan to judge or an odometry pose to judge it at (a gap's guess).
+  if (!predicted_by_odometry_ || static_cast<int>(scan_base.size()) < config_.min_scan_points)
+    return misfits_ > 0;
+  // The registration against the map failed: a scan mostly of new territory (exploring; the
+  // previous scan places it and it joins the map, as in the thesis), or a scan that
+  // contradicts the map where it is placed (its rays cross mapped walls). A scan point
+  // within two fusion radii of map structure is on it (the 0.1 m the relocaliser counts),
+  // a map point stands for half a fusion radius either side (the map's spacing), and the
+  // scan's wrong points are the relocaliser's outlier share.
+  const RayAgreement agreement =
+      ray_agreement(scan_base, estimate.T_map_base, map_.points(), 2.0 * config_.map.fusion_radius_m,
+                    0.5 * config_.map.fusion_radius_m);
+  if (agreement.contradicts(config_.relocalizer.outlier_share)) ++misfits_;
+  // Until the map is matched again, nothing joins it: after a contradiction the next scans
+  // sit at the same wrong pose, whether or not they cross the map's walls themselves.
+  return misfits_ > 0;
+}
+
+void Slam::search_map() {
+  Points2 positions;
+  positions.reserve(map_.points().size());
+  for (const MapPoint &p : map_.points()) positions.push_back(p.position_m);
+  relocalizer_ = std::make_unique<Relocalizer>(positions, config_.relocalizer);
+}
+
+FrameEstimate Slam::search_lost(const Points2 &scan_base, const std::optional<Eigen::Isometry2d> &T_odom_base,
+                                const Eigen::Isometry2d &predicted, const Eigen::Isometry2d &step) {
+  FrameEstimate estimate;
+  estimate.T_map_base = predicted;  // dead reckoning from the last tracked frame
+  estimate.lost = true;
+  const LocalizationResult found = relocalizer_->process(scan_base, T_odom_base);
+  if (found.state != LocalizationState::kLocalized) {
+    estimate.covariance = published_covariance(estimate, frame_term(estimate, step));
+    return finish_frame(estimate, scan_base, T_odom_base, false);
+  }
+  // Found: tracking resumes at the confirmed pose, on the map as it is.
+  relocalizer_.reset();
+  misfits_ = 0;
+  estimate.T_map_base = found.T_map_base;
+  estimate.lost = false;
+  estimate.relocalized = estimate.integrated = true;
+  estimate.attempt = Attempt::kMap;
+  // The map here was built from poses as uncertain as the track was when it was lost (the
+  // walk never shrinks), and this pose adds the registration's own error to it.
+  walk_covariance_ = walk_before_lost_ + found.covariance;
+  walk_dof_ = walk_dof_before_lost_;
+  estimate.covariance = predictive_covariance(walk_covariance_, walk_dof_);
+  uncommitted_covariance_.setZero();
+  since_keyframe_covariance_ = found.covariance;  // a registration against the keyframe's part of the map
+  tied_ = false;                                  // until a loop closure ties the new trail
+  last_mapped_.reset();                           // the next frame that fits the map is integrated
+  relaxation_percent_ = 0.0;
+  bool in_graph = false;
+  if (config_.loop_closure.enabled) {
+    // Anchored to the nearest keyframe: the next keyframe's sequential edge starts there,
+    // not at the keyframe the robot was carried away from.
+    if (const int keyframe = keyframes_.nearest(found.T_map_base); keyframe >= 0) {
+      keyframes_.add_revisit(keyframe, found.T_map_base);
+      in_graph = true;
+    }
+  }
+  // The scans before the jump sit at the old poses: the whole map stands in for them.
+  recent_scans_map_.assign(1, map_.index().points());
+  estimate = finish_frame(estimate, scan_base, T_odom_base, in_graph);
+  last_step_ = Eigen::Isometry2d::Identity();  // no motion is extrapolated across the jump
+  return estimate;
+}
+
+FrameEstimate Slam::finish_frame(FrameEstimate estimate, const Points2 &scan_base,
+                                 const std::optional<Eigen::Isometry2d> &T_odom_base, bool in_graph) {
   if (!in_graph) keyframes_.add_pose(estimate.T_map_base);
   estimate.trajectory_index = keyframes_.frame_count() - 1;
   // A background job's result applied before this frame.

@@ -135,6 +135,8 @@ class KeyframeGraph {
   /// trail just laid) and that a loop edge joins (matched by a fit constrained in every
   /// direction), or -1.
   [[nodiscard]] int revisited(const Eigen::Isometry2d &T_map_base, double min_path_gap_m) const;
+  /// The keyframe nearest `T_map_base` in position, or -1 when there is none.
+  [[nodiscard]] int nearest(const Eigen::Isometry2d &T_map_base) const;
   /// Records an integrated frame in a place the graph already holds: anchored to keyframe
   /// `keyframe` (its pose relative to it, so it follows the graph) and its scan (base_link)
   /// stored there, no new keyframe. The next keyframe is joined to `keyframe` by its

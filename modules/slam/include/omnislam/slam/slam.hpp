@@ -13,6 +13,7 @@
 #include "omnislam/slam/loop_job.hpp"
 #include "omnislam/slam/nearest_neighbors.hpp"
 #include "omnislam/slam/point_map.hpp"
+#include "omnislam/slam/relocalizer.hpp"
 #include "omnislam/slam/trimmed_icp.hpp"
 
 /// @file
@@ -73,6 +74,19 @@ struct SlamConfig {
   /// still, or creeping, integrates nothing, one driving at 0.5 m/s every third frame. 0:
   /// every accepted frame (the thesis; its images lie 0.15-1 m apart).
   double map_min_step_m = 0.05;
+  /// Tracking lost (a kidnapped robot: lifted, pushed or towed with its wheels off the floor,
+  /// or odometry that jumped). With odometry and registration against the map, a frame the
+  /// map registration rejects is judged along its rays (slam/ray_agreement.hpp): a scan
+  /// mostly of new territory joins the map as before (placed by the previous scan), one
+  /// whose rays cross the map's walls where it is placed contradicts the map, and from then
+  /// on until the map is matched again no frame joins it. After this many contradicting
+  /// frames the robot is lost: nothing is integrated, and each frame is searched for on the
+  /// whole map (Relocalizer, `relocalizer`) until one pose is confirmed, where tracking and
+  /// mapping resume. Three, as many frames as the relocaliser needs to confirm a pose:
+  /// leaving the tracking takes the same evidence as re-entering it. 0: never lost (the
+  /// thesis: a frame registered against the previous scan alone is integrated).
+  int lost_after_frames = 3;
+  RelocalizerConfig relocalizer;
   /// Keyframes, a pose graph over them and loop closure (beyond the thesis). When a loop
   /// closes, the keyframe poses are optimised, the map is rebuilt from them and the current
   /// pose follows the correction.
@@ -109,6 +123,15 @@ struct FrameEstimate {
   /// (inline loop closure) or a job's result applied just before it (background).
   bool loop_closed = false;
   bool map_rebuilt = false;  ///< ... and the map was rebuilt from the optimised keyframes
+  /// The scan contradicted the map where it was placed, or a scan did since the map was last
+  /// matched (SlamConfig::lost_after_frames): kept out of the map, and of anything else built
+  /// from scans at their poses (the occupancy grid).
+  bool unfit = false;
+  /// Tracking is lost (SlamConfig::lost_after_frames): this frame's pose is the odometry's
+  /// from the last tracked frame, not confirmed; nothing is integrated until a pose is found.
+  bool lost = false;
+  /// The frame a lost robot was found again at (its pose from the whole-map search).
+  bool relocalized = false;
   /// This frame's index in Slam::trajectory() (-1: not recorded there, e.g. the frame a
   /// relocalisation confirmed; the trajectory starts afresh at resume()).
   int trajectory_index = -1;
@@ -179,6 +202,8 @@ class Slam {
   [[nodiscard]] std::vector<Eigen::Isometry2d> trajectory() const { return keyframes_.trajectory(); }
   [[nodiscard]] const KeyframeGraph &keyframes() const { return keyframes_; }
   [[nodiscard]] int loop_closures() const { return loop_closures_; }
+  /// Tracking is lost: frames are searched for on the whole map.
+  [[nodiscard]] bool lost() const { return relocalizer_ != nullptr; }
 
   /// With loop_closure.background: the loop job of the newest keyframe, once a keyframe was
   /// made and no job is out (at most one at a time: keyframes made while one is out are
@@ -217,6 +242,21 @@ class Slam {
   [[nodiscard]] double registration_reach_m(const Points2 &scan_base) const;
   void set_anchor(const Eigen::Isometry2d &T_odom_base, const Eigen::Isometry2d &T_map_base);
   [[nodiscard]] FrameEstimate seed_map(const Points2 &scan_base);
+  /// Whether the frame must stay out of the map (with lost_after_frames; false when it is
+  /// off): its scan contradicts the map where it is placed (slam/ray_agreement.hpp), or did
+  /// since the map was last matched. Counts such frames until the map is matched again.
+  [[nodiscard]] bool count_misfit(const Points2 &scan_base, const FrameEstimate &estimate);
+  /// Starts (or, on a corrected map, restarts) the search of the whole map for the robot.
+  void search_map();
+  /// A lost frame: searched for on the map; when found, tracking resumes there.
+  [[nodiscard]] FrameEstimate search_lost(const Points2 &scan_base,
+                                          const std::optional<Eigen::Isometry2d> &T_odom_base,
+                                          const Eigen::Isometry2d &predicted, const Eigen::Isometry2d &step);
+  /// What every frame ends with: its place in the trajectory (unless the graph recorded it),
+  /// the loop flags, and the state the next frame is predicted from.
+  [[nodiscard]] FrameEstimate finish_frame(FrameEstimate estimate, const Points2 &scan_base,
+                                           const std::optional<Eigen::Isometry2d> &T_odom_base,
+                                           bool in_graph);
   [[nodiscard]] bool accept_without_odometry(const TrimmedIcpResult &registration,
                                              const Eigen::Isometry2d &predicted,
                                              const Eigen::Isometry2d &estimate) const;
@@ -276,6 +316,12 @@ class Slam {
   /// the next accepted frame is integrated (map_min_step_m).
   std::optional<Eigen::Isometry2d> last_mapped_;
   bool previous_failed_ = false;
+  int misfits_ = 0;  ///< frames whose scan contradicted the map since it was last matched
+  /// While lost: the search over the map as it was when the track was lost.
+  std::unique_ptr<Relocalizer> relocalizer_;
+  /// The published walk at the last tracked frame: a pose found on the map inherits it.
+  Eigen::Matrix3d walk_before_lost_ = Eigen::Matrix3d::Zero();
+  double walk_dof_before_lost_ = std::numeric_limits<double>::infinity();
 };
 
 }  // namespace omnislam::slam

@@ -1,0 +1,177 @@
+#include <algorithm>
+#include <catch2/catch.hpp>
+#include <cstdio>
+#include <cstdlib>
+#include <limits>
+#include <random>
+
+#include "omnislam/slam/odometry_noise.hpp"
+#include "omnislam/slam/slam.hpp"
+#include "synthetic_room.hpp"
+
+// A kidnapped robot (slam::SlamConfig::lost_after_frames): lifted, pushed or towed to another
+// place while its odometry reports (nearly) no motion. Tracking must notice that the scans no
+// longer fit the map, keep the map clean, find the robot on its map and go on from there.
+
+using omnislam::slam::Slam;
+using omnislam::slam::SlamConfig;
+using omnislam::test::Segment;
+
+namespace {
+
+double distance_to_walls(const std::vector<Segment> &walls, const Eigen::Vector2d &p) {
+  double best = std::numeric_limits<double>::infinity();
+  for (const Segment &s : walls) {
+    const Eigen::Vector2d e = s.b - s.a;
+    const double t = std::clamp((p - s.a).dot(e) / e.squaredNorm(), 0.0, 1.0);
+    best = std::min(best, (s.a + t * e - p).norm());
+  }
+  return best;
+}
+
+// A tour of l_room() that maps the room, then is carried (at frame `at`, after the tour) to
+// where frame `to` of the tour was and drives on from there to the tour's end.
+struct Kidnap {
+  std::vector<Eigen::Isometry2d> truth;
+  std::vector<Eigen::Isometry2d> odometry;  // blind to the carrying
+  std::size_t at = 0;                       // the first frame after the carrying
+};
+
+Kidnap kidnapped_tour(std::size_t to, std::uint64_t seed) {
+  const std::vector<Eigen::Isometry2d> tour = omnislam::test::laps_along(omnislam::test::l_room_tour(), 1);
+  Kidnap k;
+  k.truth = tour;
+  k.at = tour.size();
+  // What the wheels report: the tour, then (no motion while carried) the rest of the tour
+  // from `to` on, composed onto the tour's last pose.
+  std::vector<Eigen::Isometry2d> felt = tour;
+  for (std::size_t i = to; i < tour.size(); ++i) {
+    k.truth.push_back(tour[i]);
+    felt.push_back(tour.back() * tour[to].inverse() * tour[i]);
+  }
+  k.odometry = omnislam::slam::apply_thesis_odometry_noise(felt, seed);
+  return k;
+}
+
+struct KidnapRun {
+  int first_lost = -1;  // frame the tracking was first reported lost at
+  int found = -1;       // frame it was found again at
+  int lost_frames = 0;
+  int mapped_while_lost = 0;       // frames lost or not fitting the map that were integrated
+  double worst_map_point_m = 0.0;  // of the final map, from the walls
+  double found_error_m = 0.0;      // of the frame it was found at
+  double worst_after_found_m = 0.0;
+};
+
+KidnapRun run_kidnap(const SlamConfig &config, const Kidnap &k, std::uint64_t seed) {
+  const std::vector<Segment> walls = omnislam::test::l_room();
+  std::mt19937_64 rng(seed);
+  Slam slam(config);
+  KidnapRun r;
+  for (std::size_t i = 0; i < k.truth.size(); ++i) {
+    const auto estimate = slam.process(omnislam::test::scan_from(walls, k.truth[i], rng), k.odometry[i]);
+    const double error_m = (estimate.T_map_base.translation() - k.truth[i].translation()).norm();
+    if (estimate.lost) {
+      ++r.lost_frames;
+      if (r.first_lost < 0) r.first_lost = static_cast<int>(i);
+    }
+    if (estimate.mapped && (estimate.lost || i >= k.at) && r.found < 0) ++r.mapped_while_lost;
+    if (estimate.relocalized && r.found < 0) {
+      r.found = static_cast<int>(i);
+      r.found_error_m = error_m;
+    }
+    if (r.found >= 0) r.worst_after_found_m = std::max(r.worst_after_found_m, error_m);
+    if (std::getenv("OMNISLAM_TRACE"))
+      std::printf("%zu err %.3f int %d mapped %d lost %d found %d att %d rms %.4f inl %.2f\n", i, error_m,
+                  estimate.integrated, estimate.mapped, estimate.lost, estimate.relocalized,
+                  static_cast<int>(estimate.attempt), std::sqrt(estimate.registration.final_error_m2),
+                  estimate.registration.inlier_share);
+  }
+  for (const auto &p : slam.map().points())
+    r.worst_map_point_m = std::max(r.worst_map_point_m, distance_to_walls(walls, p.position_m));
+  return r;
+}
+
+}  // namespace
+
+TEST_CASE("SLAM: a robot carried to another mapped place is lost, found on its map, and the map stays clean",
+          "[slam][kidnap]") {
+  // Tour frames 12 (along the first leg) and 40 (back along the long side, facing the other
+  // way): 2.4 and 2.7 m from where the tour ends.
+  for (std::size_t to : {std::size_t{12}, std::size_t{40}}) {
+    for (std::uint64_t seed : {1u, 2u}) {
+      const Kidnap k = kidnapped_tour(to, seed);
+      const KidnapRun r = run_kidnap(SlamConfig{}, k, seed);
+      INFO("carried to tour frame " << to << ", seed " << seed << ": lost at " << r.first_lost
+                                    << " (carried at " << k.at << "), found at " << r.found << " with "
+                                    << r.found_error_m << " m, worst after " << r.worst_after_found_m
+                                    << " m, " << r.mapped_while_lost << " mapped while lost, worst map point "
+                                    << r.worst_map_point_m << " m");
+      // Lost within lost_after_frames of the carrying, never before it.
+      CHECK(r.first_lost >= static_cast<int>(k.at));
+      CHECK(r.first_lost < static_cast<int>(k.at) + SlamConfig{}.lost_after_frames);
+      // Found once the search has confirmed a pose (three frames), at the true place.
+      REQUIRE(r.found >= 0);
+      CHECK(r.found <= r.first_lost + 6);
+      CHECK(r.found_error_m < 0.05);
+      CHECK(r.worst_after_found_m < 0.08);
+      // Nothing seen from the wrong pose reached the map.
+      CHECK(r.mapped_while_lost == 0);
+      CHECK(r.worst_map_point_m < 0.1);
+    }
+  }
+}
+
+TEST_CASE("SLAM: without lost detection the same carrying writes the scans into the map at the wrong pose",
+          "[slam][kidnap]") {
+  // What lost_after_frames prevents (the test above would not notice if the carrying were
+  // harmless): a scan that fits the previous scan but not the map is integrated, and the map
+  // holds walls where there are none.
+  SlamConfig config;
+  config.lost_after_frames = 0;
+  const Kidnap k = kidnapped_tour(40, 1);
+  const KidnapRun r = run_kidnap(config, k, 1);
+  INFO("worst map point " << r.worst_map_point_m << " m, mapped after the carrying " << r.mapped_while_lost);
+  CHECK(r.first_lost < 0);
+  CHECK(r.found < 0);
+  CHECK(r.worst_map_point_m > 0.5);
+}
+
+TEST_CASE("SLAM: a scan that does not fit the map for a frame or two is not mapped and the track holds",
+          "[slam][kidnap]") {
+  // Someone stepping in front of the camera: two frames whose scans show a close wall of
+  // legs, not the room. Neither is integrated, the robot is never lost, tracking goes on.
+  const std::vector<Segment> walls = omnislam::test::l_room();
+  const std::vector<Eigen::Isometry2d> truth = omnislam::test::laps_along(omnislam::test::l_room_tour(), 1);
+  const auto odometry = omnislam::slam::apply_thesis_odometry_noise(truth, 3);
+  std::mt19937_64 rng(3);
+  Slam slam;
+  double worst_m = 0.0;
+  int lost = 0, mapped_blocked = 0;
+  for (std::size_t i = 0; i < truth.size(); ++i) {
+    omnislam::slam::Points2 scan = omnislam::test::scan_from(walls, truth[i], rng);
+    const bool blocked = i == 20 || i == 21;
+    if (blocked) {
+      // A ring of clutter 0.5-0.8 m around the robot on every side.
+      scan.clear();
+      std::uniform_real_distribution<double> range(0.5, 0.8);
+      for (int deg = 0; deg < 360; deg += 2) {
+        const double a = deg * std::numbers::pi / 180.0, r = range(rng);
+        scan.emplace_back(r * std::cos(a), r * std::sin(a));
+      }
+    }
+    const auto estimate = slam.process(scan, odometry[i]);
+    lost += estimate.lost ? 1 : 0;
+    mapped_blocked += blocked && estimate.mapped ? 1 : 0;
+    if (!blocked)
+      worst_m = std::max(worst_m, (estimate.T_map_base.translation() - truth[i].translation()).norm());
+  }
+  double worst_map_point_m = 0.0;
+  for (const auto &p : slam.map().points())
+    worst_map_point_m = std::max(worst_map_point_m, distance_to_walls(walls, p.position_m));
+  INFO("worst " << worst_m << " m, worst map point " << worst_map_point_m << " m");
+  CHECK(lost == 0);
+  CHECK(mapped_blocked == 0);
+  CHECK(worst_m < 0.05);
+  CHECK(worst_map_point_m < 0.1);
+}
