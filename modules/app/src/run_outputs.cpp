@@ -215,8 +215,12 @@ void OutputWriter::write_all(const RunRecord &all, const slam::PointMap &map, co
     }
   }
   summary["lost_spans"] = spans;
-  summary["relocalized"] =
-      std::count_if(all.frames.begin(), all.frames.end(), [](auto &f) { return f.relocalized; });
+  // The frames a pose was confirmed at by the search of the map (1-based).
+  nlohmann::json relocalized = nlohmann::json::array();
+  for (std::size_t i = 0; i < all.frames.size(); ++i)
+    if (all.frames[i].relocalized) relocalized.push_back(i + 1);
+  summary["relocalized"] = relocalized.size();
+  summary["relocalized_frames"] = relocalized;
   summary["keyframes"] =
       std::count_if(run.frames.begin(), run.frames.end(), [](auto &f) { return f.keyframe; });
   summary["revisits"] =

@@ -20,7 +20,7 @@ int bin_of(double bearing_rad) {
 }  // namespace
 
 RayAgreement ray_agreement(const Points2 &scan_base, const Eigen::Isometry2d &T_map_base,
-                           std::span<const MapPoint> map, double margin_m, double point_radius_m) {
+                           std::span<const Point2> map_points, double margin_m, double point_radius_m) {
   RayAgreement agreement;
   if (scan_base.empty()) return agreement;
   double farthest_m = 0.0;
@@ -30,8 +30,8 @@ RayAgreement ray_agreement(const Points2 &scan_base, const Eigen::Isometry2d &T_
   nearest_m.fill(std::numeric_limits<double>::infinity());
   const Eigen::Isometry2d T_base_map = T_map_base.inverse();
   const double reach_m = farthest_m + margin_m;
-  for (const MapPoint &point : map) {
-    const Point2 p = T_base_map * point.position_m;
+  for (const Point2 &point : map_points) {
+    const Point2 p = T_base_map * point;
     const double range_m = p.norm();
     if (range_m > reach_m || range_m <= point_radius_m) continue;
     const double half_width_rad = std::asin(point_radius_m / range_m);

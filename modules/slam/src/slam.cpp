@@ -153,10 +153,13 @@ FrameEstimate Slam::register_scan(const Points2 &scan_base, const Eigen::Isometr
     return true;
   };
 
-  if (config_.target == RegistrationTarget::kMap &&
-      try_forward(map_.index_near(transformed(scan_base, predicted), registration_reach_m(scan_base)),
-                  Attempt::kMap))
-    return estimate;
+  map_fit_.reset();
+  if (config_.target == RegistrationTarget::kMap) {
+    if (try_forward(map_.index_near(transformed(scan_base, predicted), registration_reach_m(scan_base)),
+                    Attempt::kMap))
+      return estimate;
+    if (estimate.registration.valid) map_fit_ = estimate.registration.T_model_sample;
+  }
   // The thesis registers against the previous scan (with odometry), or against each of
   // the last three (without), forward then reverse.
   const std::size_t scans = config_.use_odometry ? 1 : recent_scans_map_.size();
@@ -207,7 +210,9 @@ void Slam::resume(std::vector<MapPoint> points, int integrations, const Eigen::I
   relaxation_percent_ = 0.0;
   previous_failed_ = false;
   misfits_ = 0;
+  doubt_ = false;
   relocalizer_.reset();
+  lost_ = false;
 }
 
 KeyframeGraph Slam::resumed_graph(const ResumedGraph &graph, int integrations) const {
@@ -247,7 +252,9 @@ void Slam::set_pose(const Eigen::Isometry2d &T_map_base, const Eigen::Matrix3d &
   relaxation_percent_ = 0.0;
   previous_failed_ = false;
   misfits_ = 0;  // the operator says where the robot is: not lost
+  doubt_ = false;
   relocalizer_.reset();
+  lost_ = false;
 }
 
 void Slam::set_anchor(const Eigen::Isometry2d &T_odom_base, const Eigen::Isometry2d &T_map_base) {
@@ -391,7 +398,7 @@ FrameEstimate Slam::process(const Points2 &scan_base, const std::optional<Eigen:
   // reason to reject a correction.
   predicted_by_odometry_ = config_.use_odometry && T_odom_base.has_value();
 
-  if (relocalizer_) return search_lost(scan_base, T_odom_base, predicted, step);
+  if (lost_) return search_lost(scan_base, T_odom_base, predicted, step);
 
   FrameEstimate estimate;
   estimate.T_map_base = predicted;
@@ -407,9 +414,9 @@ FrameEstimate Slam::process(const Points2 &scan_base, const std::optional<Eigen:
       estimate.T_map_base = refined.T_model_sample;
   }
 
-  // A scan that contradicts the map where it is placed is not added to it, even when it
-  // fits the previous scan: after a kidnapping both scans sit at the wrong pose.
-  const bool misfit = count_misfit(scan_base, estimate);
+  // A scan that contradicts the map or the previous scan is not added to the map, nor any
+  // after it until the map is matched again: after a kidnapping they sit at the wrong pose.
+  const bool misfit = count_misfit(scan_base, estimate, predicted);
   estimate.unfit = misfit;
   bool in_graph = false;  // recorded as an integrated frame of the keyframe graph
   uncommitted_covariance_ = estimate.integrated ? Eigen::Matrix3d::Zero() : prediction_covariance_;
@@ -455,39 +462,94 @@ FrameEstimate Slam::process(const Points2 &scan_base, const std::optional<Eigen:
   } else {
     relaxation_percent_ += config_.srel_relax_percent;
   }
-  if (config_.lost_after_frames > 0 && misfits_ >= config_.lost_after_frames) {
-    walk_before_lost_ = walk_covariance_;
-    walk_dof_before_lost_ = walk_dof_;
-    search_map();
-    estimate.lost = true;
+  // In doubt the whole map is searched too: a pose it confirms ends the doubt, where the
+  // tracking is or elsewhere (where the robot was carried: found before it was even
+  // declared lost), and tracking goes on from it. Where nothing on the map looks like the scans (no
+  // hypothesis) while they agree with each other, the robot is exploring: after a keyframe's distance of that
+  // the map takes frames again.
+  if (!doubt_) {
+    relocalizer_.reset();
+  } else {
+    if (!relocalizer_) {
+      walk_before_lost_ = walk_covariance_;
+      walk_dof_before_lost_ = walk_dof_;
+      search_map();
+      unmatched_m_ = 0.0;
+    }
+    const LocalizationResult found = relocalizer_->process(scan_base, T_odom_base);
+    if (found.state == LocalizationState::kLocalized) {
+      // Confirmed on the map: where the tracking is (which drifted meanwhile, placed by
+      // scan-to-scan registration alone) or elsewhere (carried there).
+      (void)published_covariance(estimate, term);  // the walk up to the confirmed pose
+      return found_again(scan_base, T_odom_base, found);
+    } else if (misfits_ >= config_.lost_after_frames) {
+      lost_ = true;
+      estimate.lost = true;
+    } else if (misfits_ == 0 && found.hypotheses == 0) {
+      unmatched_m_ += step.translation().norm();
+      if (unmatched_m_ >= config_.loop_closure.keyframes.keyframe_distance_m) doubt_ = false;
+    } else {
+      unmatched_m_ = 0.0;
+    }
+    if (!doubt_) relocalizer_.reset();
   }
   estimate.covariance = published_covariance(estimate, term);
   return finish_frame(estimate, scan_base, T_odom_base, in_graph);
 }
 
-bool Slam::count_misfit(const Points2 &scan_base, const FrameEstimate &estimate) {
+bool Slam::count_misfit(const Points2 &scan_base, const FrameEstimate &estimate,
+                        const Eigen::Isometry2d &predicted) {
   if (config_.lost_after_frames <= 0 || !config_.use_odometry || config_.target != RegistrationTarget::kMap)
     return false;
   if (estimate.integrated && estimate.attempt == Attempt::kMap) {
     misfits_ = 0;
+    doubt_ = false;
     return false;
   }
   // No judgement without a scan to judge or an odometry pose to judge it at (a gap's guess).
-  if (!predicted_by_odometry_ || static_cast<int>(scan_base.size()) < config_.min_scan_points)
-    return misfits_ > 0;
-  // The registration against the map failed: a scan mostly of new territory (exploring; the
-  // previous scan places it and it joins the map, as in the thesis), or a scan that
-  // contradicts the map where it is placed (its rays cross mapped walls). A scan point
-  // within two fusion radii of map structure is on it (the 0.1 m the relocaliser counts),
-  // a map point stands for half a fusion radius either side (the map's spacing), and the
-  // scan's wrong points are the relocaliser's outlier share.
-  const RayAgreement agreement =
-      ray_agreement(scan_base, estimate.T_map_base, map_.points(), 2.0 * config_.map.fusion_radius_m,
-                    0.5 * config_.map.fusion_radius_m);
-  if (agreement.contradicts(config_.relocalizer.outlier_share)) ++misfits_;
-  // Until the map is matched again, nothing joins it: after a contradiction the next scans
-  // sit at the same wrong pose, whether or not they cross the map's walls themselves.
-  return misfits_ > 0;
+  if (!predicted_by_odometry_ || static_cast<int>(scan_base.size()) < config_.min_scan_points ||
+      recent_scans_map_.empty())
+    return doubt_;
+  // The registration against the map failed. Exploring, the scan is mostly new territory:
+  // the previous scan places it, and it joins the map as in the thesis. It does not when it
+  // contradicts the previous scan where the odometry puts it (the view changed as no
+  // motion of the robot can change it: carried off, or something right in front of the
+  // camera), when its rays cross the map's walls where it is placed, or when a misfit came
+  // since the map was last matched (the scans since sit at the same wrong pose). Two scans
+  // contradict when the rays of either cross the other's structure (slam/ray_agreement.hpp):
+  // one way alone misses a carrying into a narrower place, whose near walls stand in the
+  // other's free space but hide nothing of it. A scan point within two fusion radii of
+  // structure is on it (the 0.1 m the relocaliser counts), a point stands for half a fusion
+  // radius either side (the map's spacing), and the scans' wrong points are the
+  // relocaliser's outlier share.
+  const double margin_m = 2.0 * config_.map.fusion_radius_m, radius_m = 0.5 * config_.map.fusion_radius_m;
+  const double outliers = config_.relocalizer.outlier_share;
+  Points2 map_points;
+  map_points.reserve(map_.points().size());
+  for (const MapPoint &p : map_.points()) map_points.push_back(p.position_m);
+  const Points2 &previous_map = recent_scans_map_.front();
+  const Points2 previous_base = transformed(previous_map, previous_.T_map_base.inverse());
+  auto consistent = [&](const Eigen::Isometry2d &T_map_base) {
+    const Eigen::Isometry2d correction = predicted.inverse() * T_map_base;
+    if (correction.translation().norm() > config_.max_correction_m ||
+        std::abs(yaw_rad_of(correction)) > config_.max_correction_rad)
+      return false;
+    // A previous scan that was itself a misfit is no reference (taken from where no scan
+    // agrees, or from inside a box in a synthetic test): the map alone judges.
+    const bool previous_agrees =
+        misfits_ > 0 ||
+        (!ray_agreement(scan_base, T_map_base, previous_map, margin_m, radius_m).contradicts(outliers) &&
+         !ray_agreement(previous_base, previous_.T_map_base, transformed(scan_base, T_map_base), margin_m,
+                        radius_m)
+              .contradicts(outliers));
+    return previous_agrees &&
+           !ray_agreement(scan_base, T_map_base, map_points, margin_m, radius_m).contradicts(outliers);
+  };
+  const bool explained = consistent(estimate.T_map_base) || (map_fit_ && consistent(*map_fit_));
+
+  misfits_ = explained ? 0 : misfits_ + 1;
+  doubt_ = doubt_ || !explained;
+  return doubt_;
 }
 
 void Slam::search_map() {
@@ -503,18 +565,23 @@ FrameEstimate Slam::search_lost(const Points2 &scan_base, const std::optional<Ei
   estimate.T_map_base = predicted;  // dead reckoning from the last tracked frame
   estimate.lost = true;
   const LocalizationResult found = relocalizer_->process(scan_base, T_odom_base);
-  if (found.state != LocalizationState::kLocalized) {
-    estimate.covariance = published_covariance(estimate, frame_term(estimate, step));
-    return finish_frame(estimate, scan_base, T_odom_base, false);
-  }
-  // Found: tracking resumes at the confirmed pose, on the map as it is.
+  if (found.state == LocalizationState::kLocalized) return found_again(scan_base, T_odom_base, found);
+  estimate.covariance = published_covariance(estimate, frame_term(estimate, step));
+  return finish_frame(estimate, scan_base, T_odom_base, false);
+}
+
+FrameEstimate Slam::found_again(const Points2 &scan_base, const std::optional<Eigen::Isometry2d> &T_odom_base,
+                                const LocalizationResult &found) {
+  // Tracking resumes at the confirmed pose, on the map as it is.
   relocalizer_.reset();
+  lost_ = false;
+  doubt_ = false;
   misfits_ = 0;
+  FrameEstimate estimate;
   estimate.T_map_base = found.T_map_base;
-  estimate.lost = false;
   estimate.relocalized = estimate.integrated = true;
   estimate.attempt = Attempt::kMap;
-  // The map here was built from poses as uncertain as the track was when it was lost (the
+  // The map here was built from poses as uncertain as the track was when the doubt began (the
   // walk never shrinks), and this pose adds the registration's own error to it.
   walk_covariance_ = walk_before_lost_ + found.covariance;
   walk_dof_ = walk_dof_before_lost_;

@@ -3,7 +3,7 @@
 #include <Eigen/Geometry>
 #include <span>
 
-#include "omnislam/slam/point_map.hpp"
+#include "omnislam/slam/nearest_neighbors.hpp"
 
 /// @file
 /// Whether a scan at a pose agrees with a map along its rays: each scan point is what its
@@ -38,7 +38,7 @@ struct RayAgreement {
 /// count as crossing it); a scan point is confirmed when the nearest map structure in its
 /// bin lies within `margin_m` of its range, seen through when it lies nearer than that.
 [[nodiscard]] RayAgreement ray_agreement(const Points2 &scan_base, const Eigen::Isometry2d &T_map_base,
-                                         std::span<const MapPoint> map, double margin_m,
+                                         std::span<const Point2> map_points, double margin_m,
                                          double point_radius_m);
 
 }  // namespace omnislam::slam

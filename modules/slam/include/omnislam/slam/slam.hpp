@@ -76,15 +76,20 @@ struct SlamConfig {
   double map_min_step_m = 0.05;
   /// Tracking lost (a kidnapped robot: lifted, pushed or towed with its wheels off the floor,
   /// or odometry that jumped). With odometry and registration against the map, a frame the
-  /// map registration rejects is judged along its rays (slam/ray_agreement.hpp): a scan
-  /// mostly of new territory joins the map as before (placed by the previous scan), one
-  /// whose rays cross the map's walls where it is placed contradicts the map, and from then
-  /// on until the map is matched again no frame joins it. After this many contradicting
-  /// frames the robot is lost: nothing is integrated, and each frame is searched for on the
-  /// whole map (Relocalizer, `relocalizer`) until one pose is confirmed, where tracking and
-  /// mapping resume. Three, as many frames as the relocaliser needs to confirm a pose:
-  /// leaving the tracking takes the same evidence as re-entering it. 0: never lost (the
-  /// thesis: a frame registered against the previous scan alone is integrated).
+  /// map registration rejects is judged: a scan mostly of new territory joins the map as
+  /// before (placed by the previous scan). It is a misfit when neither where it is placed
+  /// nor where the map registration converged explains it: the previous scan's and its own
+  /// rays cross each other's walls, or its rays cross the map's (slam/ray_agreement.hpp).
+  /// From a misfit on the robot is in doubt: no frame joins the map, and each frame is also
+  /// searched for on the whole map (Relocalizer, `relocalizer`). The doubt ends when the map
+  /// registration fits again, when the search confirms a pose where the tracking is, when
+  /// the search confirms one elsewhere (where the robot was carried: tracking resumes
+  /// there), or when the robot has explored a keyframe's distance with agreeing scans that
+  /// nothing on the map resembles. After this many misfits in a row the robot is lost: its
+  /// poses are dead reckoning, not published, until the search confirms one. Three, as many
+  /// frames as the relocaliser needs to confirm a pose: leaving the tracking takes the same
+  /// evidence as re-entering it. 0: never (the thesis: a frame registered against the
+  /// previous scan alone is integrated).
   int lost_after_frames = 3;
   RelocalizerConfig relocalizer;
   /// Keyframes, a pose graph over them and loop closure (beyond the thesis). When a loop
@@ -123,9 +128,10 @@ struct FrameEstimate {
   /// (inline loop closure) or a job's result applied just before it (background).
   bool loop_closed = false;
   bool map_rebuilt = false;  ///< ... and the map was rebuilt from the optimised keyframes
-  /// The scan contradicted the map where it was placed, or a scan did since the map was last
-  /// matched (SlamConfig::lost_after_frames): kept out of the map, and of anything else built
-  /// from scans at their poses (the occupancy grid).
+  /// A misfit (SlamConfig::lost_after_frames): the scan contradicted the previous scan or
+  /// the map, or a misfit came since the map was last matched.
+  /// Kept out of the map, and of anything else built from scans at their poses (the
+  /// occupancy grid).
   bool unfit = false;
   /// Tracking is lost (SlamConfig::lost_after_frames): this frame's pose is the odometry's
   /// from the last tracked frame, not confirmed; nothing is integrated until a pose is found.
@@ -203,7 +209,7 @@ class Slam {
   [[nodiscard]] const KeyframeGraph &keyframes() const { return keyframes_; }
   [[nodiscard]] int loop_closures() const { return loop_closures_; }
   /// Tracking is lost: frames are searched for on the whole map.
-  [[nodiscard]] bool lost() const { return relocalizer_ != nullptr; }
+  [[nodiscard]] bool lost() const { return lost_; }
 
   /// With loop_closure.background: the loop job of the newest keyframe, once a keyframe was
   /// made and no job is out (at most one at a time: keyframes made while one is out are
@@ -242,16 +248,21 @@ class Slam {
   [[nodiscard]] double registration_reach_m(const Points2 &scan_base) const;
   void set_anchor(const Eigen::Isometry2d &T_odom_base, const Eigen::Isometry2d &T_map_base);
   [[nodiscard]] FrameEstimate seed_map(const Points2 &scan_base);
-  /// Whether the frame must stay out of the map (with lost_after_frames; false when it is
-  /// off): its scan contradicts the map where it is placed (slam/ray_agreement.hpp), or did
-  /// since the map was last matched. Counts such frames until the map is matched again.
-  [[nodiscard]] bool count_misfit(const Points2 &scan_base, const FrameEstimate &estimate);
+  /// Judges a frame the map registration rejected (SlamConfig::lost_after_frames: false when
+  /// it is off): counts misfits in a row, and returns whether the robot is in doubt (the
+  /// frame must stay out of the map).
+  [[nodiscard]] bool count_misfit(const Points2 &scan_base, const FrameEstimate &estimate,
+                                  const Eigen::Isometry2d &predicted);
   /// Starts (or, on a corrected map, restarts) the search of the whole map for the robot.
   void search_map();
   /// A lost frame: searched for on the map; when found, tracking resumes there.
   [[nodiscard]] FrameEstimate search_lost(const Points2 &scan_base,
                                           const std::optional<Eigen::Isometry2d> &T_odom_base,
                                           const Eigen::Isometry2d &predicted, const Eigen::Isometry2d &step);
+  /// A pose the search confirmed (in doubt or lost): tracking resumes there.
+  [[nodiscard]] FrameEstimate found_again(const Points2 &scan_base,
+                                          const std::optional<Eigen::Isometry2d> &T_odom_base,
+                                          const LocalizationResult &found);
   /// What every frame ends with: its place in the trajectory (unless the graph recorded it),
   /// the loop flags, and the state the next frame is predicted from.
   [[nodiscard]] FrameEstimate finish_frame(FrameEstimate estimate, const Points2 &scan_base,
@@ -316,10 +327,15 @@ class Slam {
   /// the next accepted frame is integrated (map_min_step_m).
   std::optional<Eigen::Isometry2d> last_mapped_;
   bool previous_failed_ = false;
-  int misfits_ = 0;  ///< frames whose scan contradicted the map since it was last matched
-  /// While lost: the search over the map as it was when the track was lost.
+  int misfits_ = 0;           ///< misfit frames in a row
+  bool doubt_ = false;        ///< a misfit came since the map was last matched: nothing joins the map
+  double unmatched_m_ = 0.0;  ///< travelled in doubt with agreeing scans that the map search does not place
+  /// Where the frame's registration against the map converged when it was rejected.
+  std::optional<Eigen::Isometry2d> map_fit_;
+  /// In doubt or lost: the search over the map as it was when the doubt began.
   std::unique_ptr<Relocalizer> relocalizer_;
-  /// The published walk at the last tracked frame: a pose found on the map inherits it.
+  bool lost_ = false;
+  /// The published walk when the doubt began: a pose found on the map inherits it.
   Eigen::Matrix3d walk_before_lost_ = Eigen::Matrix3d::Zero();
   double walk_dof_before_lost_ = std::numeric_limits<double>::infinity();
 };
