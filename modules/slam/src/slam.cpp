@@ -207,6 +207,7 @@ void Slam::resume(std::vector<MapPoint> points, int integrations, const Eigen::I
   since_keyframe_covariance_.setZero();  // the saved pose is taken as is
   // Until a scan has been seen, the whole map stands in for the previous local map.
   recent_scans_map_.assign(1, map_.index().points());
+  previous_is_scan_ = false;
   relaxation_percent_ = 0.0;
   previous_failed_ = false;
   misfits_ = 0;
@@ -249,6 +250,7 @@ void Slam::set_pose(const Eigen::Isometry2d &T_map_base, const Eigen::Matrix3d &
   last_step_ = Eigen::Isometry2d::Identity();
   // The scans before the jump sit at the old poses: the whole map stands in for them.
   if (!map_.empty()) recent_scans_map_.assign(1, map_.index().points());
+  previous_is_scan_ = false;
   relaxation_percent_ = 0.0;
   previous_failed_ = false;
   misfits_ = 0;  // the operator says where the robot is: not lost
@@ -535,9 +537,10 @@ bool Slam::count_misfit(const Points2 &scan_base, const FrameEstimate &estimate,
         std::abs(yaw_rad_of(correction)) > config_.max_correction_rad)
       return false;
     // A previous scan that was itself a misfit is no reference (taken from where no scan
-    // agrees, or from inside a box in a synthetic test): the map alone judges.
+    // agrees, or from inside a box in a synthetic test), nor is the whole map that stands in
+    // for it after an operator's pose or a resume: the map alone judges.
     const bool previous_agrees =
-        misfits_ > 0 ||
+        misfits_ > 0 || !previous_is_scan_ ||
         (!ray_agreement(scan_base, T_map_base, previous_map, margin_m, radius_m).contradicts(outliers) &&
          !ray_agreement(previous_base, previous_.T_map_base, transformed(scan_base, T_map_base), margin_m,
                         radius_m)
@@ -621,6 +624,7 @@ FrameEstimate Slam::finish_frame(FrameEstimate estimate, const Points2 &scan_bas
   last_step_ = orthonormalized(previous_.T_map_base.inverse() * estimate.T_map_base);
   // Thesis fig. 5.3: second_last = last every iteration, integrated or not.
   recent_scans_map_.push_front(transformed(scan_base, estimate.T_map_base));
+  previous_is_scan_ = true;
   if (recent_scans_map_.size() > 3) recent_scans_map_.pop_back();
   previous_ = estimate;
   return estimate;

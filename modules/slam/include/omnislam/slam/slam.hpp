@@ -327,6 +327,8 @@ class Slam {
   /// the next accepted frame is integrated (map_min_step_m).
   std::optional<Eigen::Isometry2d> last_mapped_;
   bool previous_failed_ = false;
+  bool previous_is_scan_ =
+      false;                  ///< recent_scans_map_'s front is the previous frame's scan (not the whole map)
   int misfits_ = 0;           ///< misfit frames in a row
   bool doubt_ = false;        ///< a misfit came since the map was last matched: nothing joins the map
   double unmatched_m_ = 0.0;  ///< travelled in doubt with agreeing scans that the map search does not place
