@@ -6,6 +6,8 @@
 #include <random>
 
 #include "omnislam/slam/odometry_noise.hpp"
+#include "omnislam/slam/planar_pose.hpp"
+#include "omnislam/slam/ray_agreement.hpp"
 #include "omnislam/slam/slam.hpp"
 #include "synthetic_room.hpp"
 
@@ -173,4 +175,30 @@ TEST_CASE("SLAM: a scan that does not fit the map for a frame or two is not mapp
   CHECK(mapped_blocked == 0);
   CHECK(worst_m < 0.05);
   CHECK(worst_map_point_m < 0.1);
+}
+
+TEST_CASE("ray agreement: a scan agrees with itself, crosses a map seen from elsewhere, sees new territory",
+          "[slam][kidnap]") {
+  using omnislam::slam::ray_agreement;
+  const std::vector<Segment> walls = omnislam::test::l_room();
+  std::mt19937_64 rng(7);
+  const Eigen::Isometry2d here = omnislam::test::pose(1.0, 0.0, 0.3);
+  const omnislam::slam::Points2 scan = omnislam::test::scan_from(walls, here, rng);
+  const omnislam::slam::Points2 map = omnislam::slam::transformed(scan, here);
+  // The same scan where it was taken: every point on the structure.
+  const auto same = ray_agreement(scan, here, map, 0.1, 0.025);
+  CHECK(same.confirmed > static_cast<int>(0.95 * scan.size()));
+  CHECK_FALSE(same.contradicts(0.1));
+  // The scan taken 2.2 m away (at (3, 1), between the boxes) placed here: many of its rays
+  // reach farther than the walls this place's scan met, crossing them.
+  const Eigen::Isometry2d there = omnislam::test::pose(3.0, 1.0, 0.3);
+  const omnislam::slam::Points2 elsewhere = omnislam::test::scan_from(walls, there, rng);
+  const auto wrong = ray_agreement(elsewhere, here, map, 0.1, 0.025);
+  INFO("wrong place: confirmed " << wrong.confirmed << ", seen through " << wrong.seen_through << ", unseen "
+                                 << wrong.unseen);
+  CHECK(wrong.contradicts(0.1));
+  // An empty map: everything is new territory, nothing contradicts.
+  const auto fresh = ray_agreement(scan, here, omnislam::slam::Points2{}, 0.1, 0.025);
+  CHECK(fresh.unseen == static_cast<int>(scan.size()));
+  CHECK_FALSE(fresh.contradicts(0.1));
 }
