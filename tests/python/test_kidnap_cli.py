@@ -82,6 +82,6 @@ def test_carried_where_the_map_has_not_been_the_robot_is_lost_and_the_map_kept(t
 
 def test_kidnap_dataset_refuses_bad_frames(tmp_path):
     made = subprocess.run([sys.executable, str(ROOT / "scripts" / "kidnap-dataset"), str(DATASETS / "l-room-1lap"),
-                           str(tmp_path / "bad"), "--at", "60", "--to", "15"], capture_output=True, text=True)
+                           str(tmp_path / "bad"), "--at", "61", "--to", "15"], capture_output=True, text=True)
     assert made.returncode != 0
-    assert "--at 60" in made.stderr
+    assert "--at 61" in made.stderr
