@@ -93,10 +93,7 @@ void Pipeline::relocalize(std::vector<slam::MapPoint> points, int integrations,
                           const slam::RelocalizerConfig &config, std::optional<slam::SearchWindow> window,
                           std::optional<slam::KeyframeGraphState> graph) {
   if (started_) throw std::logic_error("Pipeline::relocalize after start");
-  slam::Points2 positions;
-  positions.reserve(points.size());
-  for (const slam::MapPoint &p : points) positions.push_back(p.position_m);
-  relocalizer_ = std::make_unique<slam::Relocalizer>(positions, config);
+  relocalizer_ = std::make_unique<slam::Relocalizer>(slam::positions_of(points), config);
   relocalizer_config_ = config;
   saved_points_ = std::move(points);
   saved_integrations_ = integrations;

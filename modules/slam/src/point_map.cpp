@@ -5,6 +5,13 @@
 #include <utility>
 
 namespace omnislam::slam {
+
+Points2 positions_of(std::span<const MapPoint> points) {
+  Points2 positions;
+  positions.reserve(points.size());
+  for (const MapPoint &p : points) positions.push_back(p.position_m);
+  return positions;
+}
 namespace {
 
 constexpr double kInfinity = std::numeric_limits<double>::infinity();

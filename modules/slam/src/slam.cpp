@@ -418,8 +418,7 @@ FrameEstimate Slam::process(const Points2 &scan_base, const std::optional<Eigen:
 
   // A scan that contradicts the map or the previous scan is not added to the map, nor any
   // after it until the map is matched again: after a kidnapping they sit at the wrong pose.
-  const bool misfit = count_misfit(scan_base, estimate, predicted);
-  estimate.unfit = misfit;
+  estimate.unfit = count_misfit(scan_base, estimate, predicted);
   bool in_graph = false;  // recorded as an integrated frame of the keyframe graph
   uncommitted_covariance_ = estimate.integrated ? Eigen::Matrix3d::Zero() : prediction_covariance_;
   // The tracking's uncertainty of this pose relative to the last keyframe: the same terms
@@ -432,7 +431,7 @@ FrameEstimate Slam::process(const Points2 &scan_base, const std::optional<Eigen:
     // A frame without odometry is registered but never changes the map: along a corridor
     // the scan fits anywhere, and only odometry tells where.
     const bool odometry_gap = config_.use_odometry && !T_odom_base;
-    if (!config_.localization_only && !odometry_gap && !misfit) {
+    if (!config_.localization_only && !odometry_gap && !estimate.unfit) {
       const LoopClosureConfig &loops = config_.loop_closure;
       const int revisited = loops.enabled && loops.reuse_keyframes && tied_
                                 ? keyframes_.revisited(estimate.T_map_base, loops.min_path_gap_m)
@@ -465,10 +464,10 @@ FrameEstimate Slam::process(const Points2 &scan_base, const std::optional<Eigen:
     relaxation_percent_ += config_.srel_relax_percent;
   }
   // In doubt the whole map is searched too: a pose it confirms ends the doubt, where the
-  // tracking is or elsewhere (where the robot was carried: found before it was even
-  // declared lost), and tracking goes on from it. Where nothing on the map looks like the scans (no
-  // hypothesis) while they agree with each other, the robot is exploring: after a keyframe's distance of that
-  // the map takes frames again.
+  // tracking is or elsewhere (where the robot was carried: found before it was even declared
+  // lost), and tracking goes on from it. Where nothing on the map looks like the scans (no
+  // hypothesis) while they agree with each other, the robot is exploring: after a keyframe's
+  // distance of that the map takes frames again.
   if (!doubt_) {
     relocalizer_.reset();
   } else {
@@ -482,7 +481,6 @@ FrameEstimate Slam::process(const Points2 &scan_base, const std::optional<Eigen:
     if (found.state == LocalizationState::kLocalized) {
       // Confirmed on the map: where the tracking is (which drifted meanwhile, placed by
       // scan-to-scan registration alone) or elsewhere (carried there).
-      (void)published_covariance(estimate, term);  // the walk up to the confirmed pose
       return found_again(scan_base, T_odom_base, found);
     } else if (misfits_ >= config_.lost_after_frames) {
       lost_ = true;
@@ -526,9 +524,7 @@ bool Slam::count_misfit(const Points2 &scan_base, const FrameEstimate &estimate,
   // relocaliser's outlier share.
   const double margin_m = 2.0 * config_.map.fusion_radius_m, radius_m = 0.5 * config_.map.fusion_radius_m;
   const double outliers = config_.relocalizer.outlier_share;
-  Points2 map_points;
-  map_points.reserve(map_.points().size());
-  for (const MapPoint &p : map_.points()) map_points.push_back(p.position_m);
+  const Points2 map_points = positions_of(map_.points());
   const Points2 &previous_map = recent_scans_map_.front();
   const Points2 previous_base = transformed(previous_map, previous_.T_map_base.inverse());
   auto consistent = [&](const Eigen::Isometry2d &T_map_base) {
@@ -556,10 +552,7 @@ bool Slam::count_misfit(const Points2 &scan_base, const FrameEstimate &estimate,
 }
 
 void Slam::search_map() {
-  Points2 positions;
-  positions.reserve(map_.points().size());
-  for (const MapPoint &p : map_.points()) positions.push_back(p.position_m);
-  relocalizer_ = std::make_unique<Relocalizer>(positions, config_.relocalizer);
+  relocalizer_ = std::make_unique<Relocalizer>(positions_of(map_.points()), config_.relocalizer);
 }
 
 FrameEstimate Slam::search_lost(const Points2 &scan_base, const std::optional<Eigen::Isometry2d> &T_odom_base,

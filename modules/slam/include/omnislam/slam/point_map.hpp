@@ -1,6 +1,7 @@
 #pragma once
 
 #include <cstddef>
+#include <span>
 #include <vector>
 
 #include "omnislam/slam/nearest_neighbors.hpp"
@@ -33,6 +34,9 @@ struct MapPoint {
   int hits = 1;        ///< how many observations were fused into it
   int first_seen = 0;  ///< integration count when it was added
 };
+
+/// The positions of map points (what the searches over a map take).
+[[nodiscard]] Points2 positions_of(std::span<const MapPoint> points);
 
 class PointMap {
  public:
