@@ -187,6 +187,55 @@ TEST_CASE("SLAM: the published covariance carries the previous pose's and adds e
   CHECK(blind.covariance(0, 0) > previous(0, 0));
 }
 
+TEST_CASE("SLAM: frames registered on the map without joining it share its covariance",
+          "[slam][covariance]") {
+  // Standing still (or creeping, under map_min_step_m a frame), each frame registers on the
+  // same map: their errors are the map's plus their own registration's, not a sum over the
+  // frames. A robot parked for an hour must publish what it published after a second; one
+  // that creeps over a metre what one that drove it in map steps publishes.
+  const auto walls = omnislam::test::l_room();
+  auto drive = [&](const std::vector<Eigen::Isometry2d> &truth, std::vector<Eigen::Matrix3d> &covariances) {
+    Slam slam;
+    std::mt19937_64 rng(21);
+    int mapped = 0;
+    for (const Eigen::Isometry2d &T : truth) {
+      const auto estimate = slam.process(omnislam::test::scan_from(walls, T, rng), T);
+      REQUIRE(estimate.integrated);
+      mapped += estimate.mapped ? 1 : 0;
+      covariances.push_back(estimate.covariance);
+    }
+    return mapped;
+  };
+  std::vector<Eigen::Isometry2d> truth;
+  for (int i = 0; i < 6; ++i) truth.push_back(pose(0.1 * i, 0.0, 0.0));
+  for (int i = 0; i < 400; ++i) truth.push_back(truth.back());  // parked
+  std::vector<Eigen::Matrix3d> parked;
+  CHECK(drive(truth, parked) == 6);
+  const double at_first_stop = parked[6].topLeftCorner<2, 2>().trace();
+  double largest = 0.0, smallest = std::numeric_limits<double>::infinity();
+  for (std::size_t i = 6; i < parked.size(); ++i) {
+    largest = std::max(largest, parked[i].topLeftCorner<2, 2>().trace());
+    smallest = std::min(smallest, parked[i].topLeftCorner<2, 2>().trace());
+  }
+  INFO("position variance parked: first " << at_first_stop << " smallest " << smallest << " largest "
+                                          << largest << " m^2");
+  CHECK(largest < 1.5 * at_first_stop);
+  CHECK(smallest > parked[5].topLeftCorner<2, 2>().trace());  // never below the map's own
+
+  // The same metre driven in 0.1 m steps and crept in 0.01 m steps (a tenth under
+  // map_min_step_m: every fifth frame joins the map).
+  std::vector<Eigen::Isometry2d> fast, slow;
+  for (int i = 0; i <= 10; ++i) fast.push_back(pose(0.1 * i, 0.0, 0.0));
+  for (int i = 0; i <= 100; ++i) slow.push_back(pose(0.01 * i, 0.0, 0.0));
+  std::vector<Eigen::Matrix3d> fast_covariances, slow_covariances;
+  drive(fast, fast_covariances);
+  CHECK(drive(slow, slow_covariances) < 30);
+  const double fast_end = fast_covariances.back().topLeftCorner<2, 2>().trace();
+  const double slow_end = slow_covariances.back().topLeftCorner<2, 2>().trace();
+  INFO("position variance after a metre: fast " << fast_end << " slow " << slow_end << " m^2");
+  CHECK(slow_end < 3.0 * fast_end);
+}
+
 TEST_CASE("SLAM: a sequential edge carries the tracking's covariance between its keyframes",
           "[slam][covariance]") {
   // The relative pose of two consecutive keyframes is as uncertain as the tracking made it:

@@ -44,12 +44,17 @@ double satterthwaite_share(const Eigen::Matrix3d &term, double dof) {
 
 }  // namespace
 
-Eigen::Matrix3d Slam::published_covariance(const FrameEstimate &estimate, const Eigen::Matrix3d &term) {
+Eigen::Matrix3d Slam::published_covariance(const FrameEstimate &estimate, const Eigen::Matrix3d &term,
+                                           bool on_map) {
   // What the pose's error against the map frame is made of. On a fixed map (localization
   // only) the registration's alone. Otherwise the map the frame registered against was
-  // built from the poses before it, whose errors it inherits: the previous pose's covariance
-  // carried to this pose plus this frame's own (the registration's, cluster-robust; the
-  // odometry step's when none was accepted), the drift of a chain of registrations. (A loop
+  // built from the poses before it, whose errors it inherits: the covariance of the last pose
+  // integrated into it carried to this pose plus this frame's own (the registration's,
+  // cluster-robust), the drift of a chain of registrations. Frames registered on the map
+  // without joining it (standing still, or in a place whose keyframe is full) share that
+  // map and do not chain: the next one starts again from the map's. A frame placed by the
+  // previous scan or by odometry alone (none accepted: the odometry step's) chains from the
+  // previous frame. (A loop
   // closure does not shrink it: taking the old keyframe's covariance there was measured
   // overconfident on building-2laps, mean NEES 148, the graph's correction leaving the
   // keyframes along the loop less certain than the one it closed on.)
@@ -66,10 +71,11 @@ Eigen::Matrix3d Slam::published_covariance(const FrameEstimate &estimate, const 
     walk_dof_ = registration.covariance_dof;
     return predictive_covariance(walk_covariance_, walk_dof_);
   }
-  const Eigen::Matrix3d before = carried(walk_covariance_, previous_.T_map_base, estimate.T_map_base);
+  const WalkAt from = on_map ? map_walk_ : WalkAt{walk_covariance_, walk_dof_, previous_.T_map_base};
+  const Eigen::Matrix3d before = carried(from.covariance, from.T_map_base, estimate.T_map_base);
   const double term_dof =
       estimate.integrated ? registration.covariance_dof : std::numeric_limits<double>::infinity();
-  const double shares = satterthwaite_share(before, walk_dof_) + satterthwaite_share(term, term_dof);
+  const double shares = satterthwaite_share(before, from.dof) + satterthwaite_share(term, term_dof);
   walk_covariance_ = before + term;
   const double size = position_size(walk_covariance_);
   walk_dof_ = shares > 0.0 ? size * size / shares : std::numeric_limits<double>::infinity();
@@ -205,6 +211,8 @@ void Slam::resume(std::vector<MapPoint> points, int integrations, const Eigen::I
   walk_covariance_ = covariance;
   walk_dof_ = std::numeric_limits<double>::infinity();
   since_keyframe_covariance_.setZero();  // the saved pose is taken as is
+  map_walk_ = {walk_covariance_, walk_dof_, T_map_base};
+  map_since_keyframe_ = {since_keyframe_covariance_, walk_dof_, T_map_base};
   // Until a scan has been seen, the whole map stands in for the previous local map.
   recent_scans_map_.assign(1, map_.index().points());
   previous_is_scan_ = false;
@@ -245,8 +253,10 @@ void Slam::set_pose(const Eigen::Isometry2d &T_map_base, const Eigen::Matrix3d &
   walk_dof_ = std::numeric_limits<double>::infinity();
   uncommitted_covariance_ = covariance;     // the operator's pose is as rough as they say
   since_keyframe_covariance_ = covariance;  // so is its relation to the last keyframe
-  tied_ = false;                            // until a loop closure confirms the jump
-  last_mapped_.reset();                     // the first frame accepted at the new pose is integrated
+  map_walk_ = {walk_covariance_, walk_dof_, T_map_base};
+  map_since_keyframe_ = {since_keyframe_covariance_, walk_dof_, T_map_base};
+  tied_ = false;         // until a loop closure confirms the jump
+  last_mapped_.reset();  // the first frame accepted at the new pose is integrated
   last_step_ = Eigen::Isometry2d::Identity();
   // The scans before the jump sit at the old poses: the whole map stands in for them.
   if (!map_.empty()) recent_scans_map_.assign(1, map_.index().points());
@@ -272,6 +282,8 @@ FrameEstimate Slam::seed_map(const Points2 &scan_base) {
   map_.integrate(recent_scans_map_.front());
   previous_.mapped = true;
   last_mapped_ = previous_.T_map_base;
+  map_walk_ = {walk_covariance_, walk_dof_, previous_.T_map_base};
+  map_since_keyframe_ = {since_keyframe_covariance_, walk_dof_, previous_.T_map_base};
   if (config_.loop_closure.enabled) {
     previous_.keyframe = keyframes_.add_integrated(scan_base, previous_.T_map_base, previous_.covariance);
   } else {
@@ -370,6 +382,8 @@ void Slam::apply_loop_result(LoopResult result) {
   previous_.T_map_base = orthonormalized(T_corrected_tracked * previous_.T_map_base);
   anchor_T_map_base_ = orthonormalized(T_corrected_tracked * anchor_T_map_base_);
   if (last_mapped_) last_mapped_ = orthonormalized(T_corrected_tracked * *last_mapped_);
+  for (WalkAt *walk : {&map_walk_, &map_since_keyframe_})
+    walk->T_map_base = orthonormalized(T_corrected_tracked * walk->T_map_base);
   for (Points2 &scan : recent_scans_map_) scan = transformed(scan, T_corrected_tracked);
 }
 
@@ -422,10 +436,14 @@ FrameEstimate Slam::process(const Points2 &scan_base, const std::optional<Eigen:
   bool in_graph = false;  // recorded as an integrated frame of the keyframe graph
   uncommitted_covariance_ = estimate.integrated ? Eigen::Matrix3d::Zero() : prediction_covariance_;
   // The tracking's uncertainty of this pose relative to the last keyframe: the same terms
-  // as the published walk's, summed from that keyframe on (the next sequential edge's).
+  // as the published walk's, summed from that keyframe on (the next sequential edge's), from
+  // the map's where the frame registered on it.
   const Eigen::Matrix3d term = frame_term(estimate, step);
+  const bool on_map = estimate.integrated && estimate.attempt == Attempt::kMap;
+  const WalkAt since_from =
+      on_map ? map_since_keyframe_ : WalkAt{since_keyframe_covariance_, walk_dof_, previous_.T_map_base};
   since_keyframe_covariance_ =
-      carried(since_keyframe_covariance_, previous_.T_map_base, estimate.T_map_base) + term;
+      carried(since_from.covariance, since_from.T_map_base, estimate.T_map_base) + term;
   if (estimate.integrated) {
     relaxation_percent_ = 0.0;
     // A frame without odometry is registered but never changes the map: along a corridor
@@ -493,7 +511,10 @@ FrameEstimate Slam::process(const Points2 &scan_base, const std::optional<Eigen:
     }
     if (!doubt_) relocalizer_.reset();
   }
-  estimate.covariance = published_covariance(estimate, term);
+  estimate.covariance = published_covariance(estimate, term, on_map);
+  if (estimate.mapped) map_walk_ = {walk_covariance_, walk_dof_, estimate.T_map_base};
+  if (estimate.mapped || estimate.revisit)
+    map_since_keyframe_ = {since_keyframe_covariance_, walk_dof_, estimate.T_map_base};
   return finish_frame(estimate, scan_base, T_odom_base, in_graph);
 }
 
@@ -562,7 +583,7 @@ FrameEstimate Slam::search_lost(const Points2 &scan_base, const std::optional<Ei
   estimate.lost = true;
   const LocalizationResult found = relocalizer_->process(scan_base, T_odom_base);
   if (found.state == LocalizationState::kLocalized) return found_again(scan_base, T_odom_base, found);
-  estimate.covariance = published_covariance(estimate, frame_term(estimate, step));
+  estimate.covariance = published_covariance(estimate, frame_term(estimate, step), false);
   return finish_frame(estimate, scan_base, T_odom_base, false);
 }
 
@@ -582,10 +603,13 @@ FrameEstimate Slam::found_again(const Points2 &scan_base, const std::optional<Ei
   walk_covariance_ = walk_before_lost_ + found.covariance;
   walk_dof_ = walk_dof_before_lost_;
   estimate.covariance = predictive_covariance(walk_covariance_, walk_dof_);
+  map_walk_ = {walk_before_lost_, walk_dof_before_lost_,
+               found.T_map_base};  // the next frames register there too
   uncommitted_covariance_.setZero();
   since_keyframe_covariance_ = found.covariance;  // a registration against the keyframe's part of the map
-  tied_ = false;                                  // until a loop closure ties the new trail
-  last_mapped_.reset();                           // the next frame that fits the map is integrated
+  map_since_keyframe_ = {since_keyframe_covariance_, walk_dof_, found.T_map_base};
+  tied_ = false;         // until a loop closure ties the new trail
+  last_mapped_.reset();  // the next frame that fits the map is integrated
   relaxation_percent_ = 0.0;
   bool in_graph = false;
   if (config_.loop_closure.enabled) {

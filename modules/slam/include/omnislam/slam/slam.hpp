@@ -232,9 +232,11 @@ class Slam {
   [[nodiscard]] bool accept(const TrimmedIcpResult &registration, const Eigen::Isometry2d &predicted,
                             const Eigen::Isometry2d &estimate, double srel_limit_percent) const;
   /// The covariance published with `estimate`, `term` what the frame adds (frame_term);
-  /// advances the random walk it is made of (walk_covariance_) to this frame.
+  /// advances the random walk it is made of (walk_covariance_) to this frame: from the map's
+  /// (map_walk_) when `on_map` (registered on the map as it stands), else from the previous
+  /// frame's.
   [[nodiscard]] Eigen::Matrix3d published_covariance(const FrameEstimate &estimate,
-                                                     const Eigen::Matrix3d &term);
+                                                     const Eigen::Matrix3d &term, bool on_map);
   /// What `estimate` adds to the uncertainty of the tracking: its registration's
   /// cluster-robust covariance, or the odometry step's when it was not integrated.
   [[nodiscard]] Eigen::Matrix3d frame_term(const FrameEstimate &estimate,
@@ -322,6 +324,20 @@ class Slam {
   /// The walk's terms since the last keyframe (map frame): the tracking's uncertainty of
   /// the current pose relative to that keyframe, the next sequential edge's covariance.
   Eigen::Matrix3d since_keyframe_covariance_ = Eigen::Matrix3d::Zero();
+  /// A walk as it stood at one pose.
+  struct WalkAt {
+    Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
+    double dof = std::numeric_limits<double>::infinity();
+    Eigen::Isometry2d T_map_base = Eigen::Isometry2d::Identity();
+  };
+  /// The map's own uncertainty: the published walk of the last frame integrated into it (or
+  /// of an operator's, a saved or a found pose). A frame registered on the map inherits it,
+  /// not the walk of the frames since: those registered on the same map, their errors do
+  /// not add up (a robot standing still for an hour is no less certain than after a second).
+  WalkAt map_walk_;
+  /// The same for since_keyframe_covariance_: its value at the last frame that joined the
+  /// map or a keyframe's place (a revisit).
+  WalkAt map_since_keyframe_;
   bool predicted_by_odometry_ = false;  ///< the current frame's prediction came from odometry
   /// The last integrated frame's pose (moved by corrections as the tracking is), or none:
   /// the next accepted frame is integrated (map_min_step_m).
