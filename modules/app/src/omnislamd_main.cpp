@@ -167,6 +167,8 @@ int run_service(const std::string &config_file) {
   std::uint64_t not_localized = 0;
   std::optional<std::uint64_t> lost_at;  // the frame the tracking was lost at, until found again
   std::uint64_t lost_frames = 0;
+  std::optional<std::uint64_t> doubt_at;  // the first frame of a run of misfits, until the map fits again
+  std::uint64_t doubt_frames = 0;
   // rt/map, snapshots, and map.yaml + map.pgm in output_dir; rebuilt when a loop closure
   // corrects the poses it was built with.
   grid::TrajectoryGrid occupancy;
@@ -218,6 +220,24 @@ int run_service(const std::string &config_file) {
       ++lost_frames;
       return;
     }
+    if (frame.estimate.unfit) {
+      // In doubt: the scan contradicts the map where odometry puts it (carried off, or
+      // something right in front of the camera). Its pose is that guess, which the scans
+      // speak against: not published, nor tf (map -> odom keeps its last, so odom -> base
+      // dead-reckons meanwhile), nor saved, until the map fits or the search confirms a pose.
+      if (!doubt_at) {
+        doubt_at = frame.sequence;
+        spdlog::info("frame {} does not fit the map where odometry puts it: pose withheld until a scan fits",
+                     frame.sequence);
+      }
+      ++doubt_frames;
+      if (publisher) publisher->scan(frame.stamp_s, frame.scan);
+      return;
+    }
+    if (doubt_at && !lost_at) {
+      spdlog::info("frame {} fits the map again (in doubt since frame {})", frame.sequence, *doubt_at);
+    }
+    doubt_at.reset();
     if (!frame.localized) {  // no pose yet: nothing to publish, grid or save
       ++not_localized;
       return;
@@ -370,6 +390,8 @@ int run_service(const std::string &config_file) {
     spdlog::info("{} frames before the pose was found on the saved map", not_localized);
   if (search_start && !posed)
     spdlog::warn("{} frames and no pose found on the saved map (it is kept unchanged)", not_localized);
+  if (doubt_frames > 0)
+    spdlog::info("{} frames in doubt before a fit or a loss (pose withheld)", doubt_frames);
   if (lost_frames > 0) {
     spdlog::info("{} frames without a pose while the tracking was lost{}", lost_frames,
                  lost_at ? fmt::format(" (lost since frame {} at the end)", *lost_at) : std::string());
