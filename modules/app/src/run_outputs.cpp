@@ -171,7 +171,8 @@ void OutputWriter::write_all(const RunRecord &all, const slam::PointMap &map, co
                              const std::vector<Eigen::Isometry2d> &optimised) const {
   // Frames still searching for their pose on a saved map have none: the pose files, the
   // covariance and the errors are of the frames that have one (all of them, unless localizing).
-  // A lost frame has its dead-reckoned pose there, as any frame not integrated (summary: lost).
+  // A lost frame has its dead-reckoned pose online; in the final trajectory too unless the
+  // robot was found again, which placed it back by odometry (summary: lost).
   const RunRecord run = with_pose(all);
   std::vector<io::StampedPose> trajectory, trajectory_online;
   std::vector<Eigen::Isometry2d> online;

@@ -172,6 +172,10 @@ void KeyframeGraph::add_pose(const Eigen::Isometry2d &T_map_base) {
   last_frame_ = T_map_base;
 }
 
+void KeyframeGraph::place_frame(int frame, const Eigen::Isometry2d &T_map_base) {
+  frames_.at(static_cast<std::size_t>(frame)) = anchor(T_map_base);
+}
+
 int KeyframeGraph::revisited(const Eigen::Isometry2d &T_map_base, double min_path_gap_m) const {
   // Only places a loop edge joins: each was matched against another visit's scans by a fit
   // constrained in every direction (the loop search refuses a plain corridor's).

@@ -222,6 +222,7 @@ void Slam::resume(std::vector<MapPoint> points, int integrations, const Eigen::I
   doubt_ = false;
   relocalizer_.reset();
   lost_ = false;
+  unplaced_.clear();
 }
 
 KeyframeGraph Slam::resumed_graph(const ResumedGraph &graph, int integrations) const {
@@ -267,6 +268,7 @@ void Slam::set_pose(const Eigen::Isometry2d &T_map_base, const Eigen::Matrix3d &
   doubt_ = false;
   relocalizer_.reset();
   lost_ = false;
+  unplaced_.clear();  // their poses stay dead-reckoned: the operator's pose is too rough to place them back
 }
 
 void Slam::set_anchor(const Eigen::Isometry2d &T_odom_base, const Eigen::Isometry2d &T_map_base) {
@@ -620,6 +622,14 @@ FrameEstimate Slam::found_again(const Points2 &scan_base, const std::optional<Ei
       in_graph = true;
     }
   }
+  // The frames since the doubt began, placed back from here by their odometry: it saw the
+  // robot's own motion since the carrying, only not the carrying itself.
+  if (T_odom_base) {
+    for (const auto &[frame, T_odom_frame] : unplaced_)
+      keyframes_.place_frame(frame,
+                             orthonormalized(found.T_map_base * T_odom_base->inverse() * T_odom_frame));
+  }
+  unplaced_.clear();
   // The scans before the jump sit at the old poses: the whole map stands in for them.
   recent_scans_map_.assign(1, map_.index().points());
   estimate = finish_frame(estimate, scan_base, T_odom_base, in_graph);
@@ -631,6 +641,11 @@ FrameEstimate Slam::finish_frame(FrameEstimate estimate, const Points2 &scan_bas
                                  const std::optional<Eigen::Isometry2d> &T_odom_base, bool in_graph) {
   if (!in_graph) keyframes_.add_pose(estimate.T_map_base);
   estimate.trajectory_index = keyframes_.frame_count() - 1;
+  if (!estimate.unfit && !estimate.lost) {
+    unplaced_.clear();  // tracked (the doubt, if any, ended where the tracking is)
+  } else if (T_odom_base) {
+    unplaced_.emplace_back(estimate.trajectory_index, *T_odom_base);
+  }
   // A background job's result applied before this frame.
   estimate.loop_closed = estimate.loop_closed || closed_since_frame_;
   estimate.map_rebuilt = estimate.map_rebuilt || rebuilt_since_frame_;

@@ -123,6 +123,11 @@ class KeyframeGraph {
   /// Records a frame that was not integrated (only its pose, relative to the keyframe the
   /// frames are anchored to: the last one, or the one revisited).
   void add_pose(const Eigen::Isometry2d &T_map_base);
+  /// Places the already recorded frame `frame` (a trajectory() index) at `T_map_base`,
+  /// anchored to the keyframe frames are anchored to now: a pose known only afterwards (the
+  /// frames of a lost stretch, placed back from where the robot was found). Out of range:
+  /// std::out_of_range.
+  void place_frame(int frame, const Eigen::Isometry2d &T_map_base);
   /// Whether a frame integrated at `T_map_base` would become a keyframe (add_integrated).
   [[nodiscard]] bool makes_keyframe(const Eigen::Isometry2d &T_map_base) const;
   /// Whether a frame at `T_map_base` has room to be integrated: it would make a keyframe, or

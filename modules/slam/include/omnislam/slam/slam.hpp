@@ -7,6 +7,8 @@
 #include <memory>
 #include <optional>
 #include <span>
+#include <utility>
+#include <vector>
 
 #include "omnislam/slam/keyframe_graph.hpp"
 #include "omnislam/slam/loop_closure.hpp"
@@ -353,6 +355,11 @@ class Slam {
   /// In doubt or lost: the search over the map as it was when the doubt began.
   std::unique_ptr<Relocalizer> relocalizer_;
   bool lost_ = false;
+  /// The frames since the doubt began (in doubt, then lost) that had odometry: their
+  /// trajectory index and odometry pose. Dead-reckoned from before the carrying while they
+  /// happen; when the search finds the robot, placed back from the found pose by their
+  /// odometry (continuous since the carrying, which it did not see).
+  std::vector<std::pair<int, Eigen::Isometry2d>> unplaced_;
   /// The published walk when the doubt began: a pose found on the map inherits it.
   Eigen::Matrix3d walk_before_lost_ = Eigen::Matrix3d::Zero();
   double walk_dof_before_lost_ = std::numeric_limits<double>::infinity();
