@@ -1,8 +1,11 @@
-"""Small readers and image helpers used by the tests."""
+"""Small readers, image helpers and the omnislamd harness used by the tests."""
 from __future__ import annotations
 
+import contextlib
 import csv
 import math
+import os
+import subprocess
 from pathlib import Path
 
 import numpy as np
@@ -10,6 +13,29 @@ import numpy as np
 from omnislam_render.geometry import between, read_tum
 
 TRAJECTORIES = Path(__file__).resolve().parents[2] / "scripts" / "omnislam_render" / "data" / "trajectories.csv"
+
+
+def dds_domain(offset: int) -> int:
+    """A DDS domain id of this test process (100-199): each DDS test file its own offset, so
+    that tests running at once do not hear each other."""
+    return 100 + (os.getpid() * 2 + offset) % 100
+
+
+@contextlib.contextmanager
+def omnislamd(work: Path, config_yaml: str):
+    """omnislamd (OMNISLAMD_BIN) on `config_yaml`, written to WORK/omnislamd.yaml, its journal
+    to WORK/omnislamd.log; killed on leaving if it is still running."""
+    config = work / "omnislamd.yaml"
+    config.write_text(config_yaml)
+    with (work / "omnislamd.log").open("w") as log:
+        service = subprocess.Popen([os.environ["OMNISLAMD_BIN"], "--config", str(config)], stdout=log,
+                                   stderr=subprocess.STDOUT)
+        try:
+            yield service
+        finally:
+            if service.poll() is None:
+                service.kill()
+                service.wait()
 
 
 def table_mm(table: str) -> list[tuple[float, float]]:

@@ -34,6 +34,7 @@ from cyclonedds.util import duration  # noqa: E402
 sys.path.insert(0, str(REPO / "scripts"))
 from omnislam_msgs import (Header_, Point_, PointCloud2_, Pose_, PoseWithCovariance_,  # noqa: E402
                            PoseWithCovarianceStamped_, Quaternion_, Status_, Time_)
+from helpers import dds_domain, omnislamd  # noqa: E402
 
 RELIABLE = Policy.Reliability.Reliable(duration(seconds=1))
 
@@ -84,17 +85,12 @@ def test_initial_pose_moves_the_map_frame_and_a_foreign_frame_is_rejected(tmp_pa
                    capture_output=True, timeout=120)
     expected = read_tum(replay / "trajectory.tum")
 
-    domain = 100 + (os.getpid() * 2 + 11) % 100  # the scheme of the other DDS tests, an offset of its own
-    config = tmp_path / "omnislamd.yaml"
-    config.write_text(f"""
+    domain = dds_domain(11)
+    with omnislamd(tmp_path, f"""
 input: {{source: dataset, path: {DATASET}, rate_hz: 0}}
 pipeline: {{mode: replay}}
 dds: {{domain_id: {domain}, wait_for_subscribers: 1, wait_timeout_s: 30}}
-""")
-    log_file = (tmp_path / "omnislamd.log").open("w")
-    service = subprocess.Popen([os.environ["OMNISLAMD_BIN"], "--config", str(config)], stdout=log_file,
-                               stderr=subprocess.STDOUT, env=dict(os.environ))
-    try:
+""") as service:
         participant = DomainParticipant(domain)
         writer = DataWriter(participant, Topic(participant, "rt/initialpose", PoseWithCovarianceStamped_),
                             qos=Qos(RELIABLE, Policy.Durability.Volatile, Policy.History.KeepLast(10)))
@@ -121,10 +117,6 @@ dds: {{domain_id: {domain}, wait_for_subscribers: 1, wait_timeout_s: 30}}
                     stopped = sample
             time.sleep(0.02)
         assert service.wait(timeout=60) == 0
-    finally:
-        if service.poll() is None:
-            service.kill()
-        log_file.close()
     log = (tmp_path / "omnislamd.log").read_text()
     for sample in pose_reader.take(N=100):  # what arrived with the final status
         if isinstance(sample, PoseWithCovarianceStamped_):
@@ -154,13 +146,12 @@ def test_initial_pose_mid_run_sets_the_next_frame_and_keeps_the_map(tmp_path):
     next frame's published pose is exactly that pose, the following ones are tracked from it
     (as the replay tracked the same frames, within 5 mm), and the map keeps what it had and
     grows out there."""
-    domain = 100 + (os.getpid() * 2 + 17) % 100
-    config = tmp_path / "omnislamd.yaml"
-    config.write_text(f"""
+    domain = dds_domain(17)
+    config_yaml = f"""
 input: {{source: dataset, path: {DATASET}, rate_hz: 10}}
 pipeline: {{mode: replay, map_rate_hz: 100}}
 dds: {{domain_id: {domain}, wait_for_subscribers: 1, wait_timeout_s: 30}}
-""")
+"""
     participant = DomainParticipant(domain)
     writer = DataWriter(participant, Topic(participant, "rt/initialpose", PoseWithCovarianceStamped_),
                         qos=Qos(RELIABLE, Policy.Durability.Volatile, Policy.History.KeepLast(10)))
@@ -168,9 +159,6 @@ dds: {{domain_id: {domain}, wait_for_subscribers: 1, wait_timeout_s: 30}}
                             qos=Qos(RELIABLE, Policy.Durability.TransientLocal, Policy.History.KeepLast(100)))
     pose_reader = DataReader(participant, Topic(participant, "rt/omnislam/pose", PoseWithCovarianceStamped_),
                              qos=Qos(RELIABLE, Policy.History.KeepLast(100)))
-    log_file = (tmp_path / "omnislamd.log").open("w")
-    service = subprocess.Popen([os.environ["OMNISLAMD_BIN"], "--config", str(config)], stdout=log_file,
-                               stderr=subprocess.STDOUT)
     poses, maps, sent_after = [], [], None
     given = (20.0, 20.0, math.radians(90))
 
@@ -184,7 +172,7 @@ dds: {{domain_id: {domain}, wait_for_subscribers: 1, wait_timeout_s: 30}}
             if isinstance(sample, PointCloud2_):
                 maps.append((len(poses), sample))
 
-    try:
+    with omnislamd(tmp_path, config_yaml) as service:
         deadline = time.monotonic() + 60
         while service.poll() is None and time.monotonic() < deadline:
             take()
@@ -193,10 +181,6 @@ dds: {{domain_id: {domain}, wait_for_subscribers: 1, wait_timeout_s: 30}}
                 sent_after = len(poses)
             time.sleep(0.01)
         assert service.wait(timeout=60) == 0
-    finally:
-        if service.poll() is None:
-            service.kill()
-        log_file.close()
     take()
     log = (tmp_path / "omnislamd.log").read_text()
     assert sent_after is not None and len(poses) == 37, log

@@ -26,6 +26,7 @@ from cyclonedds.util import duration  # noqa: E402
 
 sys.path.insert(0, str(REPO / "scripts"))
 from omnislam_msgs import PoseWithCovarianceStamped_, Status_  # noqa: E402
+from helpers import dds_domain, omnislamd  # noqa: E402
 
 RELIABLE = Policy.Reliability.Reliable(duration(seconds=1))
 
@@ -38,37 +39,28 @@ def test_kidnapped_robot_is_reported_lost_publishes_nothing_and_is_found_again(t
     assert made.returncode == 0, made.stderr
     frames = 20 + (119 - 40 + 1)
 
-    domain = 100 + (os.getpid() * 2 + 19) % 100  # the scheme of the other DDS tests, an offset of its own
-    config = tmp_path / "omnislamd.yaml"
-    config.write_text(f"""
-input: {{source: dataset, path: {dataset}, rate_hz: 0}}
-pipeline: {{mode: replay}}
-dds: {{domain_id: {domain}, wait_for_subscribers: 1, wait_timeout_s: 30}}
-""")
+    domain = dds_domain(19)
     participant = DomainParticipant(domain)
     status_reader = DataReader(participant, Topic(participant, "rt/omnislam/status", Status_),
                                qos=Qos(RELIABLE, Policy.Durability.TransientLocal, Policy.History.KeepLast(100)))
     pose_reader = DataReader(participant, Topic(participant, "rt/omnislam/pose", PoseWithCovarianceStamped_),
                              qos=Qos(RELIABLE, Policy.History.KeepLast(200)))
-    log_file = (tmp_path / "omnislamd.log").open("w")
-    service = subprocess.Popen([os.environ["OMNISLAMD_BIN"], "--config", str(config)], stdout=log_file,
-                               stderr=subprocess.STDOUT, env=dict(os.environ))
     poses, statuses = [], []
 
     def take():
         poses.extend(s for s in pose_reader.take(N=200) if isinstance(s, PoseWithCovarianceStamped_))
         statuses.extend(s for s in status_reader.take(N=100) if isinstance(s, Status_))
 
-    try:
+    with omnislamd(tmp_path, f"""
+input: {{source: dataset, path: {dataset}, rate_hz: 0}}
+pipeline: {{mode: replay}}
+dds: {{domain_id: {domain}, wait_for_subscribers: 1, wait_timeout_s: 30}}
+""") as service:
         deadline = time.monotonic() + 120
         while service.poll() is None and time.monotonic() < deadline:
             take()
             time.sleep(0.02)
         assert service.wait(timeout=60) == 0
-    finally:
-        if service.poll() is None:
-            service.kill()
-        log_file.close()
     time.sleep(0.5)
     take()
     log = (tmp_path / "omnislamd.log").read_text()

@@ -29,6 +29,7 @@ os.environ.setdefault("CYCLONEDDS_URI", (REPO / "deploy" / "cyclonedds.xml").as_
 sys.path.insert(0, str(REPO / "scripts"))
 import omnislam_msgs as m  # noqa: E402
 from omnislam_ros2 import PUBLISHED, TOPICS, typestore  # noqa: E402
+from helpers import dds_domain  # noqa: E402
 from rosbags.rosbag2 import Reader  # noqa: E402
 
 
@@ -58,7 +59,7 @@ def nav2_trinary(yaml_file: Path):
 @pytest.fixture(scope="module")
 def run(tmp_path_factory):
     work = tmp_path_factory.mktemp("interop")
-    domain = 100 + (os.getpid() * 2 + 13) % 100  # the scheme of the other DDS tests, an offset of its own
+    domain = dds_domain(13)
     config = work / "omnislamd.yaml"
     config.write_text(f"""
 input: {{source: dataset, path: {DATASET}, rate_hz: 20}}

@@ -71,7 +71,7 @@ Eigen::Matrix3d Slam::published_covariance(const FrameEstimate &estimate, const 
     walk_dof_ = registration.covariance_dof;
     return predictive_covariance(walk_covariance_, walk_dof_);
   }
-  const WalkAt from = on_map ? map_walk_ : WalkAt{walk_covariance_, walk_dof_, previous_.T_map_base};
+  const WalkAt from = on_map ? map_walk_ : WalkAt{walk_covariance_, previous_.T_map_base, walk_dof_};
   const Eigen::Matrix3d before = carried(from.covariance, from.T_map_base, estimate.T_map_base);
   const double term_dof =
       estimate.integrated ? registration.covariance_dof : std::numeric_limits<double>::infinity();
@@ -211,8 +211,7 @@ void Slam::resume(std::vector<MapPoint> points, int integrations, const Eigen::I
   walk_covariance_ = covariance;
   walk_dof_ = std::numeric_limits<double>::infinity();
   since_keyframe_covariance_.setZero();  // the saved pose is taken as is
-  map_walk_ = {walk_covariance_, walk_dof_, T_map_base};
-  map_since_keyframe_ = {since_keyframe_covariance_, walk_dof_, T_map_base};
+  anchor_walks_at(T_map_base);
   // Until a scan has been seen, the whole map stands in for the previous local map.
   recent_scans_map_.assign(1, map_.index().points());
   previous_is_scan_ = false;
@@ -254,8 +253,7 @@ void Slam::set_pose(const Eigen::Isometry2d &T_map_base, const Eigen::Matrix3d &
   walk_dof_ = std::numeric_limits<double>::infinity();
   uncommitted_covariance_ = covariance;     // the operator's pose is as rough as they say
   since_keyframe_covariance_ = covariance;  // so is its relation to the last keyframe
-  map_walk_ = {walk_covariance_, walk_dof_, T_map_base};
-  map_since_keyframe_ = {since_keyframe_covariance_, walk_dof_, T_map_base};
+  anchor_walks_at(T_map_base);
   tied_ = false;         // until a loop closure confirms the jump
   last_mapped_.reset();  // the first frame accepted at the new pose is integrated
   last_step_ = Eigen::Isometry2d::Identity();
@@ -271,6 +269,11 @@ void Slam::set_pose(const Eigen::Isometry2d &T_map_base, const Eigen::Matrix3d &
   unplaced_.clear();  // their poses stay dead-reckoned: the operator's pose is too rough to place them back
 }
 
+void Slam::anchor_walks_at(const Eigen::Isometry2d &T_map_base) {
+  map_walk_ = {walk_covariance_, T_map_base, walk_dof_};
+  map_since_keyframe_ = {since_keyframe_covariance_, T_map_base};
+}
+
 void Slam::set_anchor(const Eigen::Isometry2d &T_odom_base, const Eigen::Isometry2d &T_map_base) {
   anchor_T_odom_base_ = T_odom_base;
   anchor_T_map_base_ = T_map_base;
@@ -284,8 +287,7 @@ FrameEstimate Slam::seed_map(const Points2 &scan_base) {
   map_.integrate(recent_scans_map_.front());
   previous_.mapped = true;
   last_mapped_ = previous_.T_map_base;
-  map_walk_ = {walk_covariance_, walk_dof_, previous_.T_map_base};
-  map_since_keyframe_ = {since_keyframe_covariance_, walk_dof_, previous_.T_map_base};
+  anchor_walks_at(previous_.T_map_base);
   if (config_.loop_closure.enabled) {
     previous_.keyframe = keyframes_.add_integrated(scan_base, previous_.T_map_base, previous_.covariance);
   } else {
@@ -443,7 +445,7 @@ FrameEstimate Slam::process(const Points2 &scan_base, const std::optional<Eigen:
   const Eigen::Matrix3d term = frame_term(estimate, step);
   const bool on_map = estimate.integrated && estimate.attempt == Attempt::kMap;
   const WalkAt since_from =
-      on_map ? map_since_keyframe_ : WalkAt{since_keyframe_covariance_, walk_dof_, previous_.T_map_base};
+      on_map ? map_since_keyframe_ : WalkAt{since_keyframe_covariance_, previous_.T_map_base};
   since_keyframe_covariance_ =
       carried(since_from.covariance, since_from.T_map_base, estimate.T_map_base) + term;
   if (estimate.integrated) {
@@ -514,9 +516,9 @@ FrameEstimate Slam::process(const Points2 &scan_base, const std::optional<Eigen:
     if (!doubt_) relocalizer_.reset();
   }
   estimate.covariance = published_covariance(estimate, term, on_map);
-  if (estimate.mapped) map_walk_ = {walk_covariance_, walk_dof_, estimate.T_map_base};
+  if (estimate.mapped) map_walk_ = {walk_covariance_, estimate.T_map_base, walk_dof_};
   if (estimate.mapped || estimate.revisit)
-    map_since_keyframe_ = {since_keyframe_covariance_, walk_dof_, estimate.T_map_base};
+    map_since_keyframe_ = {since_keyframe_covariance_, estimate.T_map_base};
   return finish_frame(estimate, scan_base, T_odom_base, in_graph);
 }
 
@@ -605,11 +607,11 @@ FrameEstimate Slam::found_again(const Points2 &scan_base, const std::optional<Ei
   walk_covariance_ = walk_before_lost_ + found.covariance;
   walk_dof_ = walk_dof_before_lost_;
   estimate.covariance = predictive_covariance(walk_covariance_, walk_dof_);
-  map_walk_ = {walk_before_lost_, walk_dof_before_lost_,
-               found.T_map_base};  // the next frames register there too
+  map_walk_ = {walk_before_lost_, found.T_map_base,
+               walk_dof_before_lost_};  // the next frames register there too
   uncommitted_covariance_.setZero();
   since_keyframe_covariance_ = found.covariance;  // a registration against the keyframe's part of the map
-  map_since_keyframe_ = {since_keyframe_covariance_, walk_dof_, found.T_map_base};
+  map_since_keyframe_ = {since_keyframe_covariance_, found.T_map_base};
   tied_ = false;         // until a loop closure ties the new trail
   last_mapped_.reset();  // the next frame that fits the map is integrated
   relaxation_percent_ = 0.0;

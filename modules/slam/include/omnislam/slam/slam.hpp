@@ -326,11 +326,11 @@ class Slam {
   /// The walk's terms since the last keyframe (map frame): the tracking's uncertainty of
   /// the current pose relative to that keyframe, the next sequential edge's covariance.
   Eigen::Matrix3d since_keyframe_covariance_ = Eigen::Matrix3d::Zero();
-  /// A walk as it stood at one pose.
+  /// A walk as it stood at one pose (with its degrees of freedom where they are kept).
   struct WalkAt {
     Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
-    double dof = std::numeric_limits<double>::infinity();
     Eigen::Isometry2d T_map_base = Eigen::Isometry2d::Identity();
+    double dof = std::numeric_limits<double>::infinity();
   };
   /// The map's own uncertainty: the published walk of the last frame integrated into it (or
   /// of an operator's, a saved or a found pose). A frame registered on the map inherits it,
@@ -340,6 +340,9 @@ class Slam {
   /// The same for since_keyframe_covariance_: its value at the last frame that joined the
   /// map or a keyframe's place (a revisit).
   WalkAt map_since_keyframe_;
+  /// Both taken from the current walk and since_keyframe_covariance_, at `T_map_base`: the
+  /// map is as certain as this pose (a fresh map, an operator's or a saved pose).
+  void anchor_walks_at(const Eigen::Isometry2d &T_map_base);
   bool predicted_by_odometry_ = false;  ///< the current frame's prediction came from odometry
   /// The last integrated frame's pose (moved by corrections as the tracking is), or none:
   /// the next accepted frame is integrated (map_min_step_m).
