@@ -172,7 +172,7 @@ void read_stereo(YamlSection &section, stereo::StereoConfig &stereo) {
     section.fail("far_cutoff_m", "must exceed near_cutoff_m");
 }
 
-// slam.loop_closure: keyframes, the pose graph and loop acceptance (README "Loop closure").
+// slam.loop_closure: keyframes, the pose graph and loop acceptance (docs/slam.md "Loop closure").
 void read_loop_closure(YamlSection &section, slam::LoopClosureConfig &loops) {
   section.read("enabled", loops.enabled);
   slam::KeyframeConfig &keyframes = loops.keyframes;

@@ -41,7 +41,7 @@ struct KeyframeConfig {
   /// through again and again, or a robot standing still, costs bounded memory and a bounded
   /// share of every map rebuild. 16 views of a place leave a fused map point a quarter of
   /// one view's noise; what the front-end gets wrong the same way every time (a few mm,
-  /// README "Front-end on real floors") more views would not remove.
+  /// docs/frontend.md "Front-end on real floors") more views would not remove.
   int max_scans = 16;
 };
 

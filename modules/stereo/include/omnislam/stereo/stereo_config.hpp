@@ -48,7 +48,8 @@ struct FloorBoundaryConfig {
   /// mirror's rays (vision/ray_subpixel.hpp), its column smoothed along itself with a
   /// Gaussian of this sigma (px), not across columns as the edge search's rows are. It
   /// removes the bend of walls seen obliquely on the realistic rooms, but off by default:
-  /// the runs' figures move both ways (README "Front-end on real floors", 2026-12-04).
+  /// the runs' figures move both ways (docs/frontend.md, "Where the degraded L-room's error
+  /// comes from", 2026-12-04).
   /// 0: the edge's own sub-pixel row.
   double contact_ray_sigma_px = 0.0;
 };
