@@ -2,7 +2,9 @@
 
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <cmath>
+#include <cstddef>
 #include <cstdint>
 #include <limits>
 #include <numbers>
@@ -51,11 +53,40 @@ RowBlend row_blend(float row, int rows) {
   return {below, clamped - static_cast<float>(below)};
 }
 
+// Below this many values nth_element is cheaper than clearing the radix histograms.
+constexpr std::size_t kRadixSelectMin = 2048;
+
+// The element nth_element would put in the middle. Large samples of non-negative values (the
+// frame's ~10,000 floor residuals) are selected by radix on their IEEE bits, which order as
+// unsigned integers: three branch-free histogram passes (11, 11 and 10 bits) instead of a
+// partition whose comparisons of random data mispredict half the time.
 float median_of(std::vector<float> &values) {
   if (values.empty()) return kNaN;
-  const auto middle = values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2);
-  std::nth_element(values.begin(), middle, values.end());
-  return *middle;
+  std::size_t rank = values.size() / 2;
+  const auto nth = [&] {
+    const auto middle = values.begin() + static_cast<std::ptrdiff_t>(rank);
+    std::nth_element(values.begin(), middle, values.end());
+    return *middle;
+  };
+  if (values.size() < kRadixSelectMin) return nth();
+  std::array<std::uint32_t, 2048> histogram{};
+  std::uint32_t prefix = 0, prefix_mask = 0;
+  for (const int shift : {21, 10, 0}) {
+    const std::uint32_t digits = shift == 0 ? 0x3ffu : 0x7ffu;
+    histogram.fill(0);
+    std::uint32_t signs = 0;
+    for (const float value : values) {
+      const auto bits = std::bit_cast<std::uint32_t>(value);
+      signs |= bits;
+      histogram[(bits >> shift) & digits] += static_cast<std::uint32_t>((bits & prefix_mask) == prefix);
+    }
+    if (signs >> 31 != 0) return nth();  // a negative value (or -0): the bits do not order it
+    std::uint32_t digit = 0;
+    while (rank >= histogram[digit]) rank -= histogram[digit++];
+    prefix |= digit << shift;
+    prefix_mask |= digits << shift;
+  }
+  return std::bit_cast<float>(prefix);
 }
 
 }  // namespace

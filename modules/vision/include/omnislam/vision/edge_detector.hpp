@@ -1,6 +1,7 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 #include <opencv2/core.hpp>
 #include <vector>
 
@@ -48,9 +49,9 @@ class EdgeDetector {
   CannyConfig config_;
   cv::Size kernel_size_;
   cv::Mat smoothed_;
-  cv::Mat magnitude_;                  ///< squared gradient magnitude, zero border of one pixel
-  cv::Mat state_;                      ///< edge map with the same border (kNotEdge ... kEdge)
-  std::vector<std::ptrdiff_t> trace_;  ///< hysteresis stack, one slot per pixel (offsets into state_)
+  std::vector<std::int32_t> magnitude_rows_;  ///< three padded rows of squared gradient magnitude
+  cv::Mat state_;                             ///< edge map with the same border (kNotEdge ... kEdge)
+  std::vector<std::ptrdiff_t> trace_;         ///< hysteresis stack, one slot per pixel (offsets into state_)
   std::size_t trace_top_ = 0;
   std::vector<std::ptrdiff_t> stack_;  ///< flood-fill scratch (offsets into state_)
   std::vector<std::ptrdiff_t> component_;
