@@ -9,7 +9,7 @@ import re
 import shutil
 import tempfile
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Callable, Sequence
 
@@ -289,10 +289,14 @@ def render_images(spec: DatasetSpec, out: Path, world: Sequence[Pose], threads: 
 
 
 def build(name: str, out: Path, frames: int | None = None, images: bool = True,
-          threads: int = 2, log=print, rig: M.Rig = M.Rig()) -> dict:
+          threads: int = 2, log=print, rig: M.Rig = M.Rig(), camera_height_m: float | None = None) -> dict:
     """Renders dataset `name` into `out`; `rig` is the assembled rig the images are taken
-    with (default: the design), written into dataset.yaml so a replay uses the true rig."""
+    with (default: the design), written into dataset.yaml so a replay uses the true rig;
+    `camera_height_m` puts the camera at another height (default: the dataset's own)."""
     spec = DATASETS[name]
+    if camera_height_m is not None and camera_height_m != spec.camera_height_m:
+        spec = replace(spec, camera_height_m=camera_height_m,
+                       description=f"{spec.description}, camera {camera_height_m:g} m up")
     t0 = time.monotonic()
     world = write_metadata(spec, out, frames, rig)
     stats = {"frames": len(world)}

@@ -406,6 +406,24 @@ def test_frames_option_limits_metadata(tmp_path):
     assert not (out / "images").exists()
 
 
+def test_camera_height_option(tmp_path):
+    """--camera-height renders the same room and path with the camera at another height:
+    dataset.yaml says so, the poses are unchanged, a height off the range is refused."""
+    out = tmp_path / "ds"
+    subprocess.run(RENDER + ["office-real", "--out", str(out), "--frames", "3", "--no-images",
+                             "--camera-height", "1.25"], check=True, capture_output=True, cwd=REPO)
+    meta = yaml.safe_load((out / "dataset.yaml").read_text())
+    assert meta["camera_height_m"] == 1.25
+    same = tmp_path / "same"
+    subprocess.run(RENDER + ["office-real", "--out", str(same), "--frames", "3", "--no-images"],
+                   check=True, capture_output=True, cwd=REPO)
+    assert yaml.safe_load((same / "dataset.yaml").read_text())["camera_height_m"] == 0.8
+    assert (out / "groundtruth.tum").read_bytes() == (same / "groundtruth.tum").read_bytes()
+    refused = subprocess.run(RENDER + ["office-real", "--out", str(tmp_path / "no"), "--no-images",
+                                       "--camera-height", "0.1"], capture_output=True, text=True, cwd=REPO)
+    assert refused.returncode != 0 and "--camera-height" in refused.stderr
+
+
 @pytest.mark.parametrize("name", DATASET_NAMES)
 def test_bundled_metadata_is_reproduced(metadata_dir, name):
     """The metadata of every bundled dataset (datasets/<name>) is what build() writes, byte for byte."""
