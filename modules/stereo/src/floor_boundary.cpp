@@ -80,7 +80,9 @@ float median_of(std::vector<float> &values) {
       signs |= bits;
       histogram[(bits >> shift) & digits] += static_cast<std::uint32_t>((bits & prefix_mask) == prefix);
     }
-    if (signs >> 31 != 0) return nth();  // a negative value (or -0): the bits do not order it
+    // A negative value (or -0) has its sign bit set and the bits do not order it (every pass
+    // sees every value, so the first one decides; OR-ing in the pass costs less than a pass).
+    if (signs >> 31 != 0) return nth();
     std::uint32_t digit = 0;
     while (rank >= histogram[digit]) rank -= histogram[digit++];
     prefix |= digit << shift;
