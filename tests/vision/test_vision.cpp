@@ -149,6 +149,45 @@ TEST_CASE("tiny edge fragments are removed, long edges kept", "[vision][canny]")
   CHECK(cv::countNonZero(edges.edges.row(149)) + cv::countNonZero(edges.edges.row(150)) >= 300);
 }
 
+TEST_CASE("fragment removal drops exactly the 8-connected Canny components below the size",
+          "[vision][canny]") {
+  cv::Mat textured(225, 360, CV_8UC1);
+  cv::RNG rng(11);
+  rng.fill(textured, cv::RNG::UNIFORM, 0, 256);
+  cv::GaussianBlur(textured, textured, cv::Size(5, 5), 1.5);
+  cv::Mat noise(textured.size(), CV_8UC1);
+  rng.fill(noise, cv::RNG::NORMAL, 0, 6);
+  cv::add(textured, noise, textured);
+  CannyConfig config;
+  config.min_fragment_px = 0;
+  EdgeImage all;
+  EdgeDetector(config).detect(textured, all);
+  cv::Mat labels, stats, centroids;
+  const int count = cv::connectedComponentsWithStats(all.edges, labels, stats, centroids, 8, CV_32S);
+  for (const int min_size : {2, 6, 20}) {
+    cv::Mat expected = cv::Mat::zeros(all.edges.size(), CV_8UC1);
+    int removed = 0, fragments = 0;
+    for (int label = 1; label < count; ++label) {
+      const int area = stats.at<int>(label, cv::CC_STAT_AREA);
+      if (area >= min_size) {
+        expected.setTo(255, labels == label);
+      } else {
+        removed += area;
+        ++fragments;
+      }
+    }
+    config.min_fragment_px = min_size;
+    EdgeImage kept;
+    EdgeDetector(config).detect(textured, kept);
+    cv::Mat differ;
+    cv::compare(expected, kept.edges, differ, cv::CMP_NE);
+    CHECK(fragments > 0);
+    CHECK(cv::countNonZero(differ) == 0);
+    CHECK(kept.canny_px == all.canny_px);
+    CHECK(kept.fragment_px_removed == removed);
+  }
+}
+
 TEST_CASE("edge selection: horizontal only, nearest (bottom) first, capped per column",
           "[vision][selection]") {
   cv::Mat pano(225, 360, CV_8UC1, cv::Scalar(60));

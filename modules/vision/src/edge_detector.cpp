@@ -2,8 +2,10 @@
 
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <opencv2/imgproc.hpp>
 
 namespace omnislam::vision {
@@ -17,6 +19,7 @@ constexpr std::uint8_t kNotEdge = 0;
 constexpr std::uint8_t kCandidate = 1;  // a local maximum between the thresholds
 constexpr std::uint8_t kVisited = 128;  // an edge pixel already assigned to a fragment
 constexpr std::uint8_t kEdge = 255;
+constexpr std::uint64_t kTopBits = 0x8080808080808080ull;
 
 // tan(22.5 deg) in Q15: the gradient points within 22.5 deg of the column axis when
 // |g_row| < tan(22.5) |g_col|, of the row axis when |g_row| > tan(67.5) |g_col|, and
@@ -24,6 +27,12 @@ constexpr std::uint8_t kEdge = 255;
 constexpr int kTan22Q15 = 13573;
 constexpr int kQ15 = 1 << 15;
 constexpr double kMaxThreshold = 32767.0;
+
+// The byte (in memory order) of a word's lowest set bit.
+int byte_of_lowest_bit(std::uint64_t word) {
+  const int byte = std::countr_zero(word) / 8;
+  return std::endian::native == std::endian::little ? byte : 7 - byte;
+}
 
 }  // namespace
 
@@ -44,8 +53,7 @@ void EdgeDetector::detect(const cv::Mat &panorama, EdgeImage &out) {
   cv::spatialGradient(smoothed_, out.grad_col, out.grad_row, 3, cv::BORDER_REPLICATE);  // Sobel 3x3
   choose_thresholds(out);
   suppress_non_maxima(out);
-  out.canny_px = trace_hysteresis();
-  remove_fragments(out);
+  trace_edges(out);
 }
 
 void EdgeDetector::suppress_non_maxima(const EdgeImage &out) {
@@ -116,36 +124,68 @@ void EdgeDetector::suppress_non_maxima(const EdgeImage &out) {
       const int edge = maximum & static_cast<int>(here > high);
       state[col] = static_cast<std::uint8_t>(maximum * kCandidate + edge * (kEdge - kCandidate));
     }
+    // Few pixels pass the high threshold: find them eight at a time (only kEdge has the
+    // top bit of its byte set) instead of storing a slot for every pixel.
     const std::ptrdiff_t first = state - origin;
-    for (int col = 0; col < columns; ++col) {
-      trace_[strong] = first + col;
-      strong += static_cast<std::size_t>(state[col] == kEdge);
+    int col = 0;
+    for (; col + 8 <= columns; col += 8) {
+      std::uint64_t word = 0;
+      std::memcpy(&word, state + col, sizeof word);
+      for (word &= kTopBits; word != 0; word &= word - 1)
+        trace_[strong++] = first + col + byte_of_lowest_bit(word);
+    }
+    for (; col < columns; ++col) {
+      if (state[col] == kEdge) trace_[strong++] = first + col;
     }
     std::rotate(std::begin(ring), std::begin(ring) + 1, std::end(ring));
   }
   trace_top_ = strong;
 }
 
-int EdgeDetector::trace_hysteresis() {
-  // Every candidate 8-connected to an edge pixel becomes one (trace_ holds, as a stack, the
-  // edges whose neighbours are still to visit).
+void EdgeDetector::trace_edges(EdgeImage &out) {
+  // Hysteresis and fragment removal in one pass over the strong pixels: the 8-connected
+  // components of the final edge map are exactly the components of (candidates + strong
+  // pixels) that hold a strong pixel, so each one is traced from its first strong pixel,
+  // counted, and dropped whole when it is a fragment. Pixels of components kept become
+  // kVisited; those of fragments, and candidates no strong pixel reaches, end as not edges.
   std::uint8_t *data = state_.ptr<std::uint8_t>(0);
   const auto step = static_cast<std::ptrdiff_t>(state_.step);
   const std::array<std::ptrdiff_t, 8> neighbours{-step - 1, -step,    -step + 1, -1,
                                                  1,         step - 1, step,      step + 1};
-  auto edges = static_cast<int>(trace_top_);
-  while (trace_top_ > 0) {
-    const std::ptrdiff_t index = trace_[--trace_top_];
-    for (const std::ptrdiff_t offset : neighbours) {
-      std::uint8_t &pixel = data[index + offset];
-      if (pixel == kCandidate) {
-        pixel = kEdge;
-        trace_[trace_top_++] = index + offset;
-        ++edges;
+  const auto min_size = static_cast<std::size_t>(std::max(1, config_.min_fragment_px));
+  // A component is at most the whole image: one slot per pixel (and one for the slot a
+  // neighbour is written to before it is known to join), allocated once per size.
+  component_.resize(trace_.size() + 1);
+  std::ptrdiff_t *component = component_.data();
+  out.canny_px = 0;
+  out.fragment_px_removed = 0;
+  for (std::size_t seed = 0; seed < trace_top_; ++seed) {
+    const std::ptrdiff_t start = trace_[seed];
+    if (data[start] != kEdge) continue;  // in a component traced from an earlier seed
+    data[start] = kVisited;
+    component[0] = start;
+    std::size_t size = 1;
+    for (std::size_t next = 0; next < size; ++next) {
+      const std::ptrdiff_t index = component[next];
+      // Half the pixels of a textured floor are candidates, at random: each neighbour is
+      // appended (and marked) without a branch, its slot kept only when it joins.
+      for (const std::ptrdiff_t offset : neighbours) {
+        std::uint8_t &pixel = data[index + offset];
+        const bool joins = (pixel == kCandidate) | (pixel == kEdge);
+        component[size] = index + offset;
+        size += static_cast<std::size_t>(joins);
+        pixel = joins ? kVisited : pixel;
       }
     }
+    out.canny_px += static_cast<int>(size);
+    if (size < min_size) {
+      for (std::size_t i = 0; i < size; ++i) data[component[i]] = kNotEdge;
+      out.fragment_px_removed += static_cast<int>(size);
+    }
   }
-  return edges;
+  trace_top_ = 0;
+  const cv::Rect interior(1, 1, out.grad_row.cols, out.grad_row.rows);
+  cv::compare(state_(interior), kVisited, out.edges, cv::CMP_EQ);
 }
 
 void EdgeDetector::choose_thresholds(EdgeImage &out) {
@@ -179,49 +219,6 @@ void EdgeDetector::choose_thresholds(EdgeImage &out) {
   }
   out.high_threshold = std::max(static_cast<double>(quantile), config_.auto_min_high_threshold);
   out.low_threshold = config_.auto_low_ratio * out.high_threshold;
-}
-
-void EdgeDetector::remove_fragments(EdgeImage &out) {
-  // 8-connected flood fill over the (sparse) edge pixels of the padded map; much cheaper
-  // than labelling the whole image. Pixels of fragments kept become kVisited, the others
-  // kNotEdge.
-  const cv::Rect interior(1, 1, out.grad_row.cols, out.grad_row.rows);
-  out.fragment_px_removed = 0;
-  if (config_.min_fragment_px <= 1 || out.canny_px == 0) {
-    cv::compare(state_(interior), kEdge, out.edges, cv::CMP_EQ);
-    return;
-  }
-  std::uint8_t *data = state_.ptr<std::uint8_t>(0);
-  const auto step = static_cast<std::ptrdiff_t>(state_.step);
-  const std::array<std::ptrdiff_t, 8> neighbours{-step - 1, -step,    -step + 1, -1,
-                                                 1,         step - 1, step,      step + 1};
-  for (int row = 1; row <= interior.height; ++row) {
-    std::uint8_t *line = state_.ptr<std::uint8_t>(row);
-    for (int col = 1; col <= interior.width; ++col) {
-      if (line[col] != kEdge) continue;
-      component_.clear();
-      stack_.clear();
-      stack_.push_back(line + col - data);
-      line[col] = kVisited;
-      while (!stack_.empty()) {
-        const std::ptrdiff_t index = stack_.back();
-        stack_.pop_back();
-        component_.push_back(index);
-        for (const std::ptrdiff_t offset : neighbours) {
-          std::uint8_t &pixel = data[index + offset];
-          if (pixel == kEdge) {
-            pixel = kVisited;
-            stack_.push_back(index + offset);
-          }
-        }
-      }
-      if (static_cast<int>(component_.size()) < config_.min_fragment_px) {
-        for (const std::ptrdiff_t index : component_) data[index] = kNotEdge;
-        out.fragment_px_removed += static_cast<int>(component_.size());
-      }
-    }
-  }
-  cv::compare(state_(interior), kVisited, out.edges, cv::CMP_EQ);
 }
 
 }  // namespace omnislam::vision

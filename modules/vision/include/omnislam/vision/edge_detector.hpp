@@ -42,19 +42,18 @@ class EdgeDetector {
   /// Local maxima of the gradient magnitude along its direction into state_: edges above
   /// the high threshold (also pushed on trace_), candidates above the low one.
   void suppress_non_maxima(const EdgeImage &out);
-  /// Hysteresis: candidates connected to edges become edges. Returns the edge pixels.
-  int trace_hysteresis();
-  void remove_fragments(EdgeImage &out);
+  /// Hysteresis (candidates connected to edges become edges) and removal of the edge
+  /// fragments below min_fragment_px, into out.edges, canny_px and fragment_px_removed.
+  void trace_edges(EdgeImage &out);
 
   CannyConfig config_;
   cv::Size kernel_size_;
   cv::Mat smoothed_;
   std::vector<std::int32_t> magnitude_rows_;  ///< three padded rows of squared gradient magnitude
   cv::Mat state_;                             ///< edge map with the same border (kNotEdge ... kEdge)
-  std::vector<std::ptrdiff_t> trace_;         ///< hysteresis stack, one slot per pixel (offsets into state_)
+  std::vector<std::ptrdiff_t> trace_;         ///< the strong pixels, one slot per pixel (offsets into state_)
   std::size_t trace_top_ = 0;
-  std::vector<std::ptrdiff_t> stack_;  ///< flood-fill scratch (offsets into state_)
-  std::vector<std::ptrdiff_t> component_;
+  std::vector<std::ptrdiff_t> component_;  ///< the edge component being traced (offsets into state_)
 };
 
 }  // namespace omnislam::vision
