@@ -11,6 +11,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "omnislam/vision/ray_subpixel.hpp"
+#include "omnislam/vision/wide_vectors.hpp"
 
 namespace omnislam::stereo {
 namespace {
@@ -249,9 +250,8 @@ float FloorBoundaryFinder::row_vote(float residual_against, float residual_for) 
   return std::min(residual_against, residual_for) > kOutlierResidual * noise_scale_ ? 0.0f : vote;
 }
 
-FloorBoundaryFinder::Verdict FloorBoundaryFinder::floor_or_vertical(int column, float edge_row,
-                                                                    float contact_row,
-                                                                    double *rows_llr) const {
+OMNISLAM_WIDE_VECTORS FloorBoundaryFinder::Verdict FloorBoundaryFinder::floor_or_vertical(
+    int column, float edge_row, float contact_row, double *rows_llr) const {
   // Wald's sequential test, rows outwards from the edge. Rows inside the edge's own blur,
   // in either lobe, measure the sub-pixel placement of a steep edge rather than the
   // hypotheses, and do not vote. (The walk is the front-end's hottest loop, some 60 rows a

@@ -8,6 +8,8 @@
 #include <cstring>
 #include <opencv2/imgproc.hpp>
 
+#include "omnislam/vision/wide_vectors.hpp"
+
 namespace omnislam::vision {
 namespace {
 
@@ -56,7 +58,7 @@ void EdgeDetector::detect(const cv::Mat &panorama, EdgeImage &out) {
   trace_edges(out);
 }
 
-void EdgeDetector::suppress_non_maxima(const EdgeImage &out) {
+OMNISLAM_WIDE_VECTORS void EdgeDetector::suppress_non_maxima(const EdgeImage &out) {
   // Canny on the L2 magnitude, as cv::Canny(dx, dy, ..., L2gradient = true) defines it, on
   // squared magnitudes in integers (the thresholds squared and floored: m > floor(t^2) is
   // sqrt(m) > t for an integer m). The magnitudes and the state map carry a border of one

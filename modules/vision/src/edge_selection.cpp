@@ -7,6 +7,7 @@
 #include <cstring>
 #include <vector>
 
+#include "omnislam/vision/wide_vectors.hpp"
 #include "parabola.hpp"
 
 namespace omnislam::vision {
@@ -54,10 +55,14 @@ int selection_margin_rows(const EdgeSelectionConfig &config) { return config.hal
 float relative_contrast(const cv::Mat &texture, int row, int column, int half_rows, int half_columns) {
   float low = 1e30f, high = -1e30f, sum = 0.0f;
   int count = 0;
+  const std::size_t step = texture.step1();
+  const float *top = texture.ptr<float>(row - half_rows);
   for (int dc = -half_columns; dc <= half_columns; ++dc) {
-    const int col = (column + dc + texture.cols) % texture.cols;
-    for (int r = row - half_rows; r <= row + half_rows; ++r) {
-      const float value = texture.at<float>(r, col);
+    int col = column + dc;
+    col += col < 0 ? texture.cols : col >= texture.cols ? -texture.cols : 0;
+    const float *pixel = top + col;
+    for (int r = 0; r <= 2 * half_rows; ++r, pixel += step) {
+      const float value = *pixel;
       low = std::min(low, value);
       high = std::max(high, value);
       sum += value;
@@ -68,8 +73,10 @@ float relative_contrast(const cv::Mat &texture, int row, int column, int half_ro
   return mean > 0.0f ? (high - low) / mean : 0.0f;
 }
 
-SelectionStats select_nearest_horizontal_edges(const EdgeImage &edges, const cv::Mat &texture,
-                                               const EdgeSelectionConfig &config, ColumnEdges &out) {
+OMNISLAM_WIDE_VECTORS SelectionStats select_nearest_horizontal_edges(const EdgeImage &edges,
+                                                                     const cv::Mat &texture,
+                                                                     const EdgeSelectionConfig &config,
+                                                                     ColumnEdges &out) {
   SelectionStats stats;
   const int rows = edges.edges.rows, columns = edges.edges.cols;
   const int margin = selection_margin_rows(config);
