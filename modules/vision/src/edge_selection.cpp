@@ -55,7 +55,7 @@ int selection_margin_rows(const EdgeSelectionConfig &config) { return config.hal
 float relative_contrast(const cv::Mat &texture, int row, int column, int half_rows, int half_columns) {
   float low = 1e30f, high = -1e30f, sum = 0.0f;
   int count = 0;
-  const std::size_t step = texture.step1();
+  const std::size_t step = texture.step[0] / sizeof(float);
   const float *top = texture.ptr<float>(row - half_rows);
   for (int dc = -half_columns; dc <= half_columns; ++dc) {
     int col = column + dc;
