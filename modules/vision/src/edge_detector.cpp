@@ -2,12 +2,12 @@
 
 #include <algorithm>
 #include <array>
-#include <bit>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
 #include <opencv2/imgproc.hpp>
 
+#include "byte_mask.hpp"
 #include "omnislam/vision/wide_vectors.hpp"
 
 namespace omnislam::vision {
@@ -29,12 +29,6 @@ constexpr std::uint64_t kTopBits = 0x8080808080808080ull;
 constexpr int kTan22Q15 = 13573;
 constexpr int kQ15 = 1 << 15;
 constexpr double kMaxThreshold = 32767.0;
-
-// The byte (in memory order) of a word's lowest set bit.
-int byte_of_lowest_bit(std::uint64_t word) {
-  const int byte = std::countr_zero(word) / 8;
-  return std::endian::native == std::endian::little ? byte : 7 - byte;
-}
 
 }  // namespace
 

@@ -1,12 +1,12 @@
 #include "omnislam/vision/edge_selection.hpp"
 
 #include <algorithm>
-#include <bit>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
 #include <vector>
 
+#include "byte_mask.hpp"
 #include "omnislam/vision/wide_vectors.hpp"
 #include "parabola.hpp"
 
@@ -15,12 +15,6 @@ namespace {
 
 int abs_row_gradient(const cv::Mat &grad_row, int row, int column) {
   return std::abs(static_cast<int>(grad_row.at<std::int16_t>(row, column)));
-}
-
-// The byte (in memory order) of a word's lowest set bit.
-int byte_of_lowest_bit(std::uint64_t word) {
-  const int byte = std::countr_zero(word) / 8;
-  return std::endian::native == std::endian::little ? byte : 7 - byte;
 }
 
 }  // namespace
