@@ -19,7 +19,7 @@ constexpr int kMagnitudeBins = 1448;
 // Pixel states of the padded edge map.
 constexpr std::uint8_t kNotEdge = 0;
 constexpr std::uint8_t kCandidate = 1;  // a local maximum between the thresholds
-constexpr std::uint8_t kVisited = 128;  // an edge pixel already assigned to a fragment
+constexpr std::uint8_t kVisited = 128;  // an edge pixel already traced into its component
 constexpr std::uint8_t kEdge = 255;
 constexpr std::uint64_t kTopBits = 0x8080808080808080ull;
 
