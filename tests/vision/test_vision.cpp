@@ -7,6 +7,7 @@
 #include <string>
 
 #include "omnislam/mirror/mirror_model.hpp"
+#include "omnislam/mirror/panorama_maps.hpp"
 #include "omnislam/vision/edge_detector.hpp"
 #include "omnislam/vision/edge_selection.hpp"
 #include "omnislam/vision/panorama_unwarper.hpp"
@@ -89,6 +90,49 @@ TEST_CASE("unwarp + edges find the convention image's floor-wall boundary at its
       CAPTURE(column, expected);
       REQUIRE(candidates.column(column).size() == 1);
       CHECK(candidates.column(column)[0].row_subpx == Approx(expected).margin(0.1));
+    }
+  }
+}
+
+TEST_CASE("the prefetch covers every pixel a lobe's samples read, and only the lobe's part of the frame",
+          "[vision][unwarp]") {
+  omnislam::mirror::MirrorConfig off_centre;  // the outer lobe's rim crosses the image border
+  off_centre.center_u_px = 470.0;
+  off_centre.center_v_px = 545.25;
+  for (const auto &config : {omnislam::mirror::MirrorConfig{}, off_centre}) {
+    const MirrorModel model(config);
+    const PanoramaUnwarper unwarper(model);
+    for (const Lobe lobe : {Lobe::kInner, Lobe::kOuter}) {
+      const omnislam::mirror::PanoramaMap map = omnislam::mirror::make_panorama_map(model, lobe);
+      const cv::Mat u(map.rows, map.columns, CV_32FC1, const_cast<float *>(map.u_px.data()));
+      const cv::Mat v(map.rows, map.columns, CV_32FC1, const_cast<float *>(map.v_px.data()));
+      cv::Mat xy, fraction;
+      cv::convertMaps(u, v, xy, fraction, CV_16SC2);
+      cv::Mat covered(config.image_height_px, config.image_width_px, CV_8UC1, cv::Scalar(0));
+      for (const PanoramaUnwarper::Span &span : unwarper.spans(lobe)) {
+        REQUIRE(span.row >= 0);
+        REQUIRE(span.row < covered.rows);
+        REQUIRE(span.first >= 0);
+        REQUIRE(span.first <= span.last);
+        REQUIRE(span.last < covered.cols);
+        covered.row(span.row).colRange(span.first, span.last + 1).setTo(1);
+      }
+      int missed = 0;
+      for (int row = 0; row < xy.rows; ++row) {
+        for (int column = 0; column < xy.cols; ++column) {
+          const cv::Vec2s position = xy.at<cv::Vec2s>(row, column);
+          for (int dy = 0; dy <= 1; ++dy) {
+            for (int dx = 0; dx <= 1; ++dx) {
+              const int x = position[0] + dx, y = position[1] + dy;
+              if (x >= 0 && x < covered.cols && y >= 0 && y < covered.rows)
+                missed += static_cast<int>(covered.at<std::uint8_t>(y, x) == 0);
+            }
+          }
+        }
+      }
+      CHECK(missed == 0);
+      // The inner lobe reads a disk, the outer lobe a ring: neither needs the whole frame.
+      CHECK(cv::countNonZero(covered) < covered.total() * (lobe == Lobe::kInner ? 0.4 : 0.8));
     }
   }
 }

@@ -110,8 +110,9 @@ bool ScanReconstructor::accepts(const cv::Mat &image) const {
 }
 
 void ScanReconstructor::unwarp(const cv::Mat &image) {
-  unwarper_.prefetch(image);
+  unwarper_.prefetch(image, mirror::Lobe::kInner);
   unwarper_.unwarp(image, mirror::Lobe::kInner, inner_.panorama);
+  unwarper_.prefetch(image, mirror::Lobe::kOuter);
   unwarper_.unwarp(image, mirror::Lobe::kOuter, outer_.panorama);
 }
 

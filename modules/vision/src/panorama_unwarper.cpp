@@ -1,10 +1,9 @@
 #include "omnislam/vision/panorama_unwarper.hpp"
 
-#include <algorithm>
-#include <cmath>
+#include <cstddef>
 #include <cstdint>
 #include <opencv2/imgproc.hpp>
-#include <utility>
+#include <vector>
 
 #include "omnislam/mirror/panorama_maps.hpp"
 
@@ -13,39 +12,70 @@ namespace {
 
 constexpr int kCacheLineBytes = 64;
 
-// Returns the range of image rows the lobe's samples (and their bilinear neighbours) touch.
-std::pair<int, int> build_maps(const mirror::MirrorModel &model, mirror::Lobe lobe, cv::Mat &xy,
-                               cv::Mat &fraction) {
+void build_maps(const mirror::MirrorModel &model, mirror::Lobe lobe, cv::Mat &xy, cv::Mat &fraction) {
   mirror::PanoramaMap map = mirror::make_panorama_map(model, lobe);
   const cv::Mat u(map.rows, map.columns, CV_32FC1, map.u_px.data());
   const cv::Mat v(map.rows, map.columns, CV_32FC1, map.v_px.data());
-  double v_min = 0.0, v_max = 0.0;
-  cv::minMaxLoc(v, &v_min, &v_max);
   // Fixed-point maps skip the per-call float conversion inside cv::remap; the position
   // quantum is 1/32 px, far below the sub-pixel accuracy the stereo needs.
   cv::convertMaps(u, v, xy, fraction, CV_16SC2);
-  return {static_cast<int>(std::floor(v_min)), static_cast<int>(std::ceil(v_max)) + 1};
+}
+
+// The image pixels a lobe's bilinear samples read (each sample's pixel and its right, lower
+// and lower-right neighbours, as cv::remap reads them from the fixed-point map), as runs of
+// columns per image row; runs closer than a cache line are one run.
+std::vector<PanoramaUnwarper::Span> sampled_spans(const cv::Mat &xy, int width, int height) {
+  std::vector<std::vector<std::uint8_t>> read(static_cast<std::size_t>(height));
+  for (int row = 0; row < xy.rows; ++row) {
+    const auto *position = xy.ptr<std::int16_t>(row);
+    for (int column = 0; column < xy.cols; ++column) {
+      const int x = position[2 * column], y = position[2 * column + 1];
+      for (int dy = 0; dy <= 1; ++dy) {
+        if (y + dy < 0 || y + dy >= height) continue;
+        auto &line = read[static_cast<std::size_t>(y + dy)];
+        if (line.empty()) line.assign(static_cast<std::size_t>(width), 0);
+        for (int dx = 0; dx <= 1; ++dx) {
+          if (x + dx >= 0 && x + dx < width) line[static_cast<std::size_t>(x + dx)] = 1;
+        }
+      }
+    }
+  }
+  std::vector<PanoramaUnwarper::Span> spans;
+  for (int row = 0; row < height; ++row) {
+    const auto &line = read[static_cast<std::size_t>(row)];
+    for (int x = 0; x < static_cast<int>(line.size()); ++x) {
+      if (line[static_cast<std::size_t>(x)] == 0) continue;
+      if (!spans.empty() && spans.back().row == row && x - spans.back().last <= kCacheLineBytes) {
+        spans.back().last = x;
+      } else {
+        spans.push_back({row, x, x});
+      }
+    }
+  }
+  return spans;
 }
 
 }  // namespace
 
 PanoramaUnwarper::PanoramaUnwarper(const mirror::MirrorModel &model)
     : rows_(model.config().rows_per_lobe), columns_(model.config().columns) {
-  const auto [inner_first, inner_last] = build_maps(model, mirror::Lobe::kInner, inner_.xy, inner_.fraction);
-  const auto [outer_first, outer_last] = build_maps(model, mirror::Lobe::kOuter, outer_.xy, outer_.fraction);
-  first_row_ = std::max(0, std::min(inner_first, outer_first));
-  last_row_ = std::min(model.config().image_height_px - 1, std::max(inner_last, outer_last));
+  const int width = model.config().image_width_px, height = model.config().image_height_px;
+  build_maps(model, mirror::Lobe::kInner, inner_.xy, inner_.fraction);
+  build_maps(model, mirror::Lobe::kOuter, outer_.xy, outer_.fraction);
+  inner_.spans = sampled_spans(inner_.xy, width, height);
+  outer_.spans = sampled_spans(outer_.xy, width, height);
 }
 
-void PanoramaUnwarper::prefetch(const cv::Mat &image) const {
-  if (image.empty()) return;
-  const int last = std::min(last_row_, image.rows - 1);
-  const auto row_bytes = static_cast<int>(image.cols * image.elemSize());
+void PanoramaUnwarper::prefetch(const cv::Mat &image, mirror::Lobe lobe) const {
+  if (image.empty() || image.elemSize() != 1) return;
+  const Maps &maps = lobe == mirror::Lobe::kInner ? inner_ : outer_;
   std::uint8_t sum = 0;
-  for (int row = first_row_; row <= last; ++row) {
-    const std::uint8_t *pixels = image.ptr<std::uint8_t>(row);
-    for (int byte = 0; byte < row_bytes; byte += kCacheLineBytes)
-      sum = static_cast<std::uint8_t>(sum + pixels[byte]);
+  for (const Span &span : maps.spans) {
+    if (span.row >= image.rows || span.last >= image.cols) continue;
+    const std::uint8_t *pixels = image.ptr<std::uint8_t>(span.row);
+    for (int x = span.first; x < span.last; x += kCacheLineBytes)
+      sum = static_cast<std::uint8_t>(sum + pixels[x]);
+    sum = static_cast<std::uint8_t>(sum + pixels[span.last]);
   }
   // A volatile store keeps the loads: the sum is otherwise dead and the loop would be dropped.
   [[maybe_unused]] volatile std::uint8_t sink = sum;
