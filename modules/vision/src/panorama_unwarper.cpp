@@ -12,15 +12,6 @@ namespace {
 
 constexpr int kCacheLineBytes = 64;
 
-void build_maps(const mirror::MirrorModel &model, mirror::Lobe lobe, cv::Mat &xy, cv::Mat &fraction) {
-  mirror::PanoramaMap map = mirror::make_panorama_map(model, lobe);
-  const cv::Mat u(map.rows, map.columns, CV_32FC1, map.u_px.data());
-  const cv::Mat v(map.rows, map.columns, CV_32FC1, map.v_px.data());
-  // Fixed-point maps skip the per-call float conversion inside cv::remap; the position
-  // quantum is 1/32 px, far below the sub-pixel accuracy the stereo needs.
-  cv::convertMaps(u, v, xy, fraction, CV_16SC2);
-}
-
 // The image pixels a lobe's bilinear samples read (each sample's pixel and its right, lower
 // and lower-right neighbours, as cv::remap reads them from the fixed-point map), as runs of
 // columns per image row; runs closer than a cache line are one run.
@@ -58,19 +49,27 @@ std::vector<PanoramaUnwarper::Span> sampled_spans(const cv::Mat &xy, int width, 
 }  // namespace
 
 PanoramaUnwarper::PanoramaUnwarper(const mirror::MirrorModel &model)
-    : rows_(model.config().rows_per_lobe), columns_(model.config().columns) {
-  const int width = model.config().image_width_px, height = model.config().image_height_px;
-  build_maps(model, mirror::Lobe::kInner, inner_.xy, inner_.fraction);
-  build_maps(model, mirror::Lobe::kOuter, outer_.xy, outer_.fraction);
-  inner_.spans = sampled_spans(inner_.xy, width, height);
-  outer_.spans = sampled_spans(outer_.xy, width, height);
+    : rows_(model.config().rows_per_lobe),
+      columns_(model.config().columns),
+      inner_(make_maps(model, mirror::Lobe::kInner)),
+      outer_(make_maps(model, mirror::Lobe::kOuter)) {}
+
+PanoramaUnwarper::Maps PanoramaUnwarper::make_maps(const mirror::MirrorModel &model, mirror::Lobe lobe) {
+  mirror::PanoramaMap map = mirror::make_panorama_map(model, lobe);
+  const cv::Mat u(map.rows, map.columns, CV_32FC1, map.u_px.data());
+  const cv::Mat v(map.rows, map.columns, CV_32FC1, map.v_px.data());
+  Maps maps;
+  // Fixed-point maps skip the per-call float conversion inside cv::remap; the position
+  // quantum is 1/32 px, far below the sub-pixel accuracy the stereo needs.
+  cv::convertMaps(u, v, maps.xy, maps.fraction, CV_16SC2);
+  maps.spans = sampled_spans(maps.xy, model.config().image_width_px, model.config().image_height_px);
+  return maps;
 }
 
 void PanoramaUnwarper::prefetch(const cv::Mat &image, mirror::Lobe lobe) const {
   if (image.empty() || image.elemSize() != 1) return;
-  const Maps &maps = lobe == mirror::Lobe::kInner ? inner_ : outer_;
   std::uint8_t sum = 0;
-  for (const Span &span : maps.spans) {
+  for (const Span &span : maps(lobe).spans) {
     if (span.row >= image.rows || span.last >= image.cols) continue;
     const std::uint8_t *pixels = image.ptr<std::uint8_t>(span.row);
     for (int x = span.first; x < span.last; x += kCacheLineBytes)
@@ -82,8 +81,8 @@ void PanoramaUnwarper::prefetch(const cv::Mat &image, mirror::Lobe lobe) const {
 }
 
 void PanoramaUnwarper::unwarp(const cv::Mat &image, mirror::Lobe lobe, cv::Mat &panorama) const {
-  const Maps &maps = lobe == mirror::Lobe::kInner ? inner_ : outer_;
-  cv::remap(image, panorama, maps.xy, maps.fraction, cv::INTER_LINEAR, cv::BORDER_CONSTANT, cv::Scalar(0));
+  cv::remap(image, panorama, maps(lobe).xy, maps(lobe).fraction, cv::INTER_LINEAR, cv::BORDER_CONSTANT,
+            cv::Scalar(0));
 }
 
 }  // namespace omnislam::vision

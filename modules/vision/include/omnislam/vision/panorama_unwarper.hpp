@@ -25,10 +25,10 @@ class PanoramaUnwarper {
   /// Reads one byte per cache line of the image pixels `lobe`'s samples read, in raster
   /// order; call it just before unwarp() of that lobe. A fresh frame is usually not in
   /// cache, and remap's arcs defeat the hardware prefetcher: one streaming pass first makes
-  /// the unwarp read from cache (2-3x faster on a new frame). Only the lobe's own annulus
-  /// is read (the inner lobe's disk, then the outer lobe's ring, 28% and 60% of the frame's
-  /// lines), so each stays in cache beside its maps: a cold unwarp of both lobes 1.01 ->
-  /// 0.78 ms against one pass over every row before both.
+  /// the unwarp read from cache (2-3x faster on a new frame). Only the lobe's own part is
+  /// read (the inner lobe's disk, the outer lobe's ring: 28% and 60% of the frame's cache
+  /// lines), so it is still in cache beside the lobe's maps when the remap runs
+  /// (docs/frontend.md, "Speed").
   void prefetch(const cv::Mat &image, mirror::Lobe lobe) const;
 
   [[nodiscard]] int rows() const { return rows_; }
@@ -41,9 +41,7 @@ class PanoramaUnwarper {
     int last = 0;
   };
   /// What prefetch() reads for `lobe`: every pixel its samples read, in raster order.
-  [[nodiscard]] const std::vector<Span> &spans(mirror::Lobe lobe) const {
-    return lobe == mirror::Lobe::kInner ? inner_.spans : outer_.spans;
-  }
+  [[nodiscard]] const std::vector<Span> &spans(mirror::Lobe lobe) const { return maps(lobe).spans; }
 
  private:
   struct Maps {
@@ -51,6 +49,11 @@ class PanoramaUnwarper {
     cv::Mat fraction;         ///< CV_16UC1 interpolation table index
     std::vector<Span> spans;  ///< the pixels the samples read, row by row
   };
+  static Maps make_maps(const mirror::MirrorModel &model, mirror::Lobe lobe);
+  [[nodiscard]] const Maps &maps(mirror::Lobe lobe) const {
+    return lobe == mirror::Lobe::kInner ? inner_ : outer_;
+  }
+
   int rows_ = 0;
   int columns_ = 0;
   Maps inner_;
