@@ -12,6 +12,11 @@
 namespace omnislam::slam {
 namespace {
 
+// The misfit test's reference: the scans of the last this many frames the map placed.
+constexpr std::size_t kAgreementFrames = 20;
+// A misfit's share of crossing points lies this many standard deviations beyond theirs.
+constexpr double kMisfitSigmas = 3.0;
+
 // Odometry uncertainty of one step, used to grow the covariance of unregistered frames
 // (the thesis noise model: 10% of the distance, 1.5 deg of heading).
 Eigen::Matrix3d odometry_step_covariance(const Eigen::Isometry2d &step) {
@@ -529,11 +534,15 @@ bool Slam::count_misfit(const Points2 &scan_base, const FrameEstimate &estimate,
   if (estimate.integrated && estimate.attempt == Attempt::kMap) {
     misfits_ = 0;
     doubt_ = false;
+    record_agreement(scan_base, estimate.T_map_base);
     return false;
   }
-  // No judgement without a scan to judge or an odometry pose to judge it at (a gap's guess).
+  // No judgement without a scan to judge or an odometry pose to judge it at (a gap's guess),
+  // nor before the run's scans have shown how much they disagree where the robot is (until
+  // the map registration first places a frame: on a floor where the front-end errs more
+  // than on the bundled ones, the first frames' disagreement is that, not a carrying).
   if (!predicted_by_odometry_ || static_cast<int>(scan_base.size()) < config_.min_scan_points ||
-      recent_scans_map_.empty())
+      recent_scans_map_.empty() || agreement_history_.empty())
     return doubt_;
   // The registration against the map failed. Exploring, the scan is mostly new territory:
   // the previous scan places it, and it joins the map as in the thesis. It does not when it
@@ -545,10 +554,9 @@ bool Slam::count_misfit(const Points2 &scan_base, const FrameEstimate &estimate,
   // one way alone misses a carrying into a narrower place, whose near walls stand in the
   // other's free space but hide nothing of it. A scan point within two fusion radii of
   // structure is on it (the 0.1 m the relocaliser counts), a point stands for half a fusion
-  // radius either side (the map's spacing), and the scans' wrong points are the
-  // relocaliser's outlier share.
+  // radius either side (the map's spacing), and the scans' wrong points are what the
+  // scans of this run show where the map placed them (contradicts()).
   const double margin_m = 2.0 * config_.map.fusion_radius_m, radius_m = 0.5 * config_.map.fusion_radius_m;
-  const double outliers = config_.relocalizer.outlier_share;
   const Points2 map_points = positions_of(map_.points());
   const Points2 &previous_map = recent_scans_map_.front();
   const Points2 previous_base = transformed(previous_map, previous_.T_map_base.inverse());
@@ -562,18 +570,50 @@ bool Slam::count_misfit(const Points2 &scan_base, const FrameEstimate &estimate,
     // for it after an operator's pose or a resume: the map alone judges.
     const bool previous_agrees =
         misfits_ > 0 || !previous_is_scan_ ||
-        (!ray_agreement(scan_base, T_map_base, previous_map, margin_m, radius_m).contradicts(outliers) &&
-         !ray_agreement(previous_base, previous_.T_map_base, transformed(scan_base, T_map_base), margin_m,
-                        radius_m)
-              .contradicts(outliers));
+        (!contradicts(ray_agreement(scan_base, T_map_base, previous_map, margin_m, radius_m)) &&
+         !contradicts(ray_agreement(previous_base, previous_.T_map_base, transformed(scan_base, T_map_base),
+                                    margin_m, radius_m)));
     return previous_agrees &&
-           !ray_agreement(scan_base, T_map_base, map_points, margin_m, radius_m).contradicts(outliers);
+           !contradicts(ray_agreement(scan_base, T_map_base, map_points, margin_m, radius_m));
   };
   const bool explained = consistent(estimate.T_map_base) || (map_fit_ && consistent(*map_fit_));
 
   misfits_ = explained ? 0 : misfits_ + 1;
   doubt_ = doubt_ || !explained;
   return doubt_;
+}
+
+void Slam::record_agreement(const Points2 &scan_base, const Eigen::Isometry2d &T_map_base) {
+  if (!previous_is_scan_ || recent_scans_map_.empty()) return;
+  const double margin_m = 2.0 * config_.map.fusion_radius_m, radius_m = 0.5 * config_.map.fusion_radius_m;
+  const Points2 &previous_map = recent_scans_map_.front();
+  const RayAgreement forward = ray_agreement(scan_base, T_map_base, previous_map, margin_m, radius_m);
+  const RayAgreement backward =
+      ray_agreement(transformed(previous_map, previous_.T_map_base.inverse()), previous_.T_map_base,
+                    transformed(scan_base, T_map_base), margin_m, radius_m);
+  agreement_history_.push_front(
+      {forward.seen_through + backward.seen_through,
+       forward.seen_through + forward.confirmed + backward.seen_through + backward.confirmed});
+  if (agreement_history_.size() > kAgreementFrames) agreement_history_.pop_back();
+}
+
+bool Slam::contradicts(const RayAgreement &agreement) const {
+  // The share of a scan that crosses structure where the robot is, pooled over the recent
+  // frames the map placed; a frame's share scatters about it binomially, its points counted
+  // at the relocaliser's correlation (neighbours share errors). A misfit lies beyond three
+  // standard deviations of that, and beyond the relocaliser's outlier share.
+  double seen = 0.0, informative = 0.0;
+  for (const AgreementTally &tally : agreement_history_) {
+    seen += tally.seen_through;
+    informative += tally.informative;
+  }
+  const double n = agreement.confirmed + agreement.seen_through;
+  if (n <= 0.0) return false;
+  const double share = informative > 0.0 ? seen / informative : 0.0;
+  const double effective = std::max(1.0, n * config_.relocalizer.point_correlation);
+  const double tolerance = std::max(config_.relocalizer.outlier_share,
+                                    share + kMisfitSigmas * std::sqrt(share * (1.0 - share) / effective));
+  return agreement.seen_through > tolerance * n;
 }
 
 void Slam::search_map() {

@@ -15,6 +15,7 @@
 #include "omnislam/slam/loop_job.hpp"
 #include "omnislam/slam/nearest_neighbors.hpp"
 #include "omnislam/slam/point_map.hpp"
+#include "omnislam/slam/ray_agreement.hpp"
 #include "omnislam/slam/relocalizer.hpp"
 #include "omnislam/slam/trimmed_icp.hpp"
 
@@ -257,6 +258,12 @@ class Slam {
   /// frame must stay out of the map).
   [[nodiscard]] bool count_misfit(const Points2 &scan_base, const FrameEstimate &estimate,
                                   const Eigen::Isometry2d &predicted);
+  /// Records how much the scan of a frame the map registration placed and the previous scan
+  /// contradict each other (the reference count_misfit judges by).
+  void record_agreement(const Points2 &scan_base, const Eigen::Isometry2d &T_map_base);
+  /// Whether `agreement` shows more of a scan crossing structure than the scans of this run
+  /// do where the robot is (agreement_history_), and more than the relocaliser's outlier share.
+  [[nodiscard]] bool contradicts(const RayAgreement &agreement) const;
   /// Starts (or, on a corrected map, restarts) the search of the whole map for the robot.
   void search_map();
   /// A lost frame: searched for on the map; when found, tracking resumes there.
@@ -349,8 +356,16 @@ class Slam {
   std::optional<Eigen::Isometry2d> last_mapped_;
   bool previous_failed_ = false;
   bool previous_is_scan_ =
-      false;                  ///< recent_scans_map_'s front is the previous frame's scan (not the whole map)
-  int misfits_ = 0;           ///< misfit frames in a row
+      false;         ///< recent_scans_map_'s front is the previous frame's scan (not the whole map)
+  int misfits_ = 0;  ///< misfit frames in a row
+  /// How much consecutive scans cross each other's structure where the map registration
+  /// placed them, over the last frames it did (per frame: seen through, and seen through or
+  /// confirmed, both ways summed): the front-end's wrong points on this floor.
+  struct AgreementTally {
+    int seen_through = 0;
+    int informative = 0;
+  };
+  std::deque<AgreementTally> agreement_history_;
   bool doubt_ = false;        ///< a misfit came since the map was last matched: nothing joins the map
   double unmatched_m_ = 0.0;  ///< travelled in doubt with agreeing scans that the map search does not place
   /// Where the frame's registration against the map converged when it was rejected.
