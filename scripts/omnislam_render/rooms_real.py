@@ -9,7 +9,8 @@ dust) are not rendered: `omnislam degrade` / `replay --degrade` add them, seeded
 """
 from __future__ import annotations
 
-from .rooms import BOXES, CABINET, CEILING, DOOR, TABLE_FOOT, TABLE_TOP, WALLS, WINDOW, l_room, sim_room
+from .rooms import (BOXES, CABINET, CEILING, DOOR, TABLE_FOOT, TABLE_TOP, WALLS, WINDOW, building_floor, l_room,
+                    sim_room)
 from .scene import AreaLamp, Box, Cylinder, Patch, Room, Rug, Skirting, Sun
 
 # Indirect light is approximated by a low ambient term; the lamps do the rest.
@@ -109,6 +110,16 @@ def checker_room() -> Room:
     sun = Sun("window", azimuth_deg=-80.0, elevation_deg=20.0, power=1.6)
     room = _realistic(sim_room(), checker_marble(), lamps, sun, (0.15, 0.12, 0.10))
     room.name = "checker-room"
+    return room
+
+
+def building_real() -> Room:
+    """A held-out scene (not bundled): the building floor with narrow light oak planks, a light
+    skirting and ceiling panels (soft shadows) over the corridors and rooms."""
+    lamps = [AreaLamp((x, y, 2.9), (1.2, 0.3), 0.30) for x, y in
+             ((4.0, 1.0), (10.0, 1.0), (16.0, 1.0), (1.0, 8.0), (19.0, 8.0), (6.0, 8.0), (14.0, 8.0))]
+    room = _realistic(building_floor(), wood_planks(900.0, 120.0), lamps, None, (0.85, 0.85, 0.82))
+    room.name = "building-real"
     return room
 
 
