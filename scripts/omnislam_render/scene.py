@@ -339,6 +339,14 @@ def frame_scene(room: Room, pose: Pose, camera_height_m: float, camera: str, mir
     )
 
 
+def _moved_left(segment: Segment, distance: float) -> Segment:
+    """An axis-aligned segment moved `distance` to its left (the free side of a boundary)."""
+    x1, y1, x2, y2 = segment
+    length = math.hypot(x2 - x1, y2 - y1)
+    nx, ny = -(y2 - y1) / length * distance, (x2 - x1) / length * distance
+    return (x1 + nx, y1 + ny, x2 + nx, y2 + ny)
+
+
 def free_space_boundary(interior: tuple[float, float, float, float], solids: Sequence[Box]) -> list[Segment]:
     """Where the free floor meets the solids, as maximal segments with the free side on their
     left (counter-clockwise around the free space, like a room outline).
@@ -408,7 +416,25 @@ class Floor(Room):
         return min(xs), min(ys), max(xs), max(ys)
 
     def walls(self) -> list[Segment]:
-        return free_space_boundary(self._interior(), self.solids)
+        """Where the free floor meets the walls, or the skirting boards' faces."""
+        segments = free_space_boundary(self._interior(), self.solids)
+        if self.skirting is None:
+            return segments
+        return [_moved_left(segment, self.skirting.depth) for segment in segments]
+
+    def _skirting_pov(self) -> list[str]:
+        # A board along every side of the free floor, on its free side (left of the segment);
+        # at a wall's end (a door's jamb) the jamb's own board meets it.
+        sk = self.skirting
+        out = []
+        for segment in free_space_boundary(self._interior(), self.solids):
+            x1, y1, x2, y2 = segment
+            a1, b1, a2, b2 = _moved_left(segment, sk.depth)
+            lo = (min(x1, x2, a1, a2), min(y1, y2, b1, b2), 0.0)
+            hi = (max(x1, x2, a1, a2), max(y1, y2, b1, b2), sk.height)
+            out.append(f"box {{ {vec(*_mm(*lo))}, {vec(*_mm(*hi))} pigment {{ {_rgb(sk.colour)} }} "
+                       f"{self.finish} }}  // skirting")
+        return out
 
     def _wall_boxes(self) -> list[str]:
         t = WALL_THICKNESS

@@ -394,6 +394,33 @@ def test_floorplan_building(metadata_dir):
     assert length == pytest.approx(64.0 - 3 * 0.15 + 16.0 + 4 * 4.3 + 2 * 7.775 + 4 * 6.1 + 6 * 0.15)
 
 
+def test_building_floor_skirting_lines_every_side_of_the_free_floor():
+    # A Floor's skirting (the held-out building-real) runs along every side of the free floor
+    # on its free side, and the plan follows the boards' faces: before, the boards were the
+    # bounding boxes of the outer outline's inset edges paired with the first four wall
+    # segments, 8 cm slabs over much of the floor.
+    room = datasets.HELD_OUT["building-real"].room()
+    bare = datasets.DATASETS["building-2laps"].room()
+    depth, height = room.skirting.depth, room.skirting.height
+    boards = [line for line in room.pov_body().splitlines() if line.strip().endswith("// skirting")]
+    assert len(boards) == len(bare.walls()) == len(room.walls())
+    for (x1, y1, x2, y2), (a1, b1, a2, b2) in zip(bare.walls(), room.walls()):
+        nx, ny = -(y2 - y1), x2 - x1          # left: the free side
+        n = math.hypot(nx, ny)
+        assert (a1, b1) == pytest.approx((x1 + depth * nx / n, y1 + depth * ny / n))
+        assert (a2, b2) == pytest.approx((x2 + depth * nx / n, y2 + depth * ny / n))
+    # every board is one side's length by the board's depth, as high as the board
+    lengths = []
+    for line in boards:
+        lo, hi = [np.array([float(v) for v in part.split(">")[0].split(",")]) for part in line.split("<")[1:3]]
+        size = np.sort(np.abs(hi[:2] - lo[:2]))
+        assert size[0] == pytest.approx(depth * 1000.0)
+        assert lo[2] == pytest.approx(0.0) and hi[2] == pytest.approx(height * 1000.0)
+        lengths.append(size[1])
+    assert sorted(lengths) == pytest.approx(
+        sorted(1000.0 * math.hypot(x2 - x1, y2 - y1) for x1, y1, x2, y2 in bare.walls()))
+
+
 def test_frames_option_limits_metadata(tmp_path):
     out = tmp_path / "ds"
     subprocess.run(RENDER + ["l-room-2laps", "--out", str(out), "--frames", "7", "--no-images"],
