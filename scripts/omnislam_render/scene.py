@@ -416,18 +416,20 @@ class Floor(Room):
         return min(xs), min(ys), max(xs), max(ys)
 
     def walls(self) -> list[Segment]:
-        """Where the free floor meets the walls, or the skirting boards' faces."""
-        segments = free_space_boundary(self._interior(), self.solids)
+        return free_space_boundary(self._interior(), self.solids)
+
+    def inner_faces(self) -> list[Segment]:
+        """Where the walls meet the floor: the walls, or the skirting boards' faces."""
         if self.skirting is None:
-            return segments
-        return [_moved_left(segment, self.skirting.depth) for segment in segments]
+            return self.walls()
+        return [_moved_left(segment, self.skirting.depth) for segment in self.walls()]
 
     def _skirting_pov(self) -> list[str]:
         # A board along every side of the free floor, on its free side (left of the segment);
         # at a wall's end (a door's jamb) the jamb's own board meets it.
         sk = self.skirting
         out = []
-        for segment in free_space_boundary(self._interior(), self.solids):
+        for segment in self.walls():
             x1, y1, x2, y2 = segment
             a1, b1, a2, b2 = _moved_left(segment, sk.depth)
             lo = (min(x1, x2, a1, a2), min(y1, y2, b1, b2), 0.0)

@@ -403,8 +403,10 @@ def test_building_floor_skirting_lines_every_side_of_the_free_floor():
     bare = datasets.DATASETS["building-2laps"].room()
     depth, height = room.skirting.depth, room.skirting.height
     boards = [line for line in room.pov_body().splitlines() if line.strip().endswith("// skirting")]
-    assert len(boards) == len(bare.walls()) == len(room.walls())
-    for (x1, y1, x2, y2), (a1, b1, a2, b2) in zip(bare.walls(), room.walls()):
+    assert len(boards) == len(bare.walls()) == len(room.inner_faces())
+    assert room.walls() == bare.walls()
+    assert set(map(tuple, room.floorplan())) >= set(map(tuple, room.inner_faces()))
+    for (x1, y1, x2, y2), (a1, b1, a2, b2) in zip(bare.walls(), room.inner_faces()):
         nx, ny = -(y2 - y1), x2 - x1          # left: the free side
         n = math.hypot(nx, ny)
         assert (a1, b1) == pytest.approx((x1 + depth * nx / n, y1 + depth * ny / n))
