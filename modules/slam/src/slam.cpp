@@ -570,11 +570,14 @@ bool Slam::count_misfit(const Points2 &scan_base, const FrameEstimate &estimate,
     // for it after an operator's pose or a resume: the map alone judges.
     const bool previous_agrees =
         misfits_ > 0 || !previous_is_scan_ ||
-        (!contradicts(ray_agreement(scan_base, T_map_base, previous_map, margin_m, radius_m)) &&
+        (!contradicts(ray_agreement(scan_base, T_map_base, previous_map, margin_m, radius_m),
+                      Reference::kPreviousScan) &&
          !contradicts(ray_agreement(previous_base, previous_.T_map_base, transformed(scan_base, T_map_base),
-                                    margin_m, radius_m)));
+                                    margin_m, radius_m),
+                      Reference::kPreviousScan));
     return previous_agrees &&
-           !contradicts(ray_agreement(scan_base, T_map_base, map_points, margin_m, radius_m));
+           !contradicts(ray_agreement(scan_base, T_map_base, map_points, margin_m, radius_m),
+                        Reference::kMap);
   };
   const bool explained = consistent(estimate.T_map_base) || (map_fit_ && consistent(*map_fit_));
 
@@ -591,21 +594,26 @@ void Slam::record_agreement(const Points2 &scan_base, const Eigen::Isometry2d &T
   const RayAgreement backward =
       ray_agreement(transformed(previous_map, previous_.T_map_base.inverse()), previous_.T_map_base,
                     transformed(scan_base, T_map_base), margin_m, radius_m);
+  // The map around the scan: the registration's own index (bounded, whatever the map's size).
+  const RayAgreement on_map = ray_agreement(scan_base, T_map_base, map_.index().points(), margin_m, radius_m);
   agreement_history_.push_front(
       {forward.seen_through + backward.seen_through,
-       forward.seen_through + forward.confirmed + backward.seen_through + backward.confirmed});
+       forward.seen_through + forward.confirmed + backward.seen_through + backward.confirmed,
+       on_map.seen_through, on_map.seen_through + on_map.confirmed});
   if (agreement_history_.size() > kAgreementFrames) agreement_history_.pop_back();
 }
 
-bool Slam::contradicts(const RayAgreement &agreement) const {
+bool Slam::contradicts(const RayAgreement &agreement, Reference reference) const {
   // The share of a scan that crosses structure where the robot is, pooled over the recent
   // frames the map placed; a frame's share scatters about it binomially, its points counted
   // at the relocaliser's correlation (neighbours share errors). A misfit lies beyond three
-  // standard deviations of that, and beyond the relocaliser's outlier share.
+  // standard deviations of that, and beyond the relocaliser's outlier share. Against the map
+  // the share is the map's own: it also holds the wrong points of every scan it fused.
+  const bool map = reference == Reference::kMap;
   double seen = 0.0, informative = 0.0;
   for (const AgreementTally &tally : agreement_history_) {
-    seen += tally.seen_through;
-    informative += tally.informative;
+    seen += map ? tally.map_seen_through : tally.seen_through;
+    informative += map ? tally.map_informative : tally.informative;
   }
   const double n = agreement.confirmed + agreement.seen_through;
   if (n <= 0.0) return false;

@@ -259,11 +259,15 @@ class Slam {
   [[nodiscard]] bool count_misfit(const Points2 &scan_base, const FrameEstimate &estimate,
                                   const Eigen::Isometry2d &predicted);
   /// Records how much the scan of a frame the map registration placed and the previous scan
-  /// contradict each other (the reference count_misfit judges by).
+  /// contradict each other, and the scan and the map around it (the references count_misfit
+  /// judges by).
   void record_agreement(const Points2 &scan_base, const Eigen::Isometry2d &T_map_base);
+  /// The two references: scans against the previous scan, or against the map.
+  enum class Reference { kPreviousScan, kMap };
   /// Whether `agreement` shows more of a scan crossing structure than the scans of this run
-  /// do where the robot is (agreement_history_), and more than the relocaliser's outlier share.
-  [[nodiscard]] bool contradicts(const RayAgreement &agreement) const;
+  /// do where the robot is (agreement_history_, against the same reference), and more than
+  /// the relocaliser's outlier share.
+  [[nodiscard]] bool contradicts(const RayAgreement &agreement, Reference reference) const;
   /// Starts (or, on a corrected map, restarts) the search of the whole map for the robot.
   void search_map();
   /// A lost frame: searched for on the map; when found, tracking resumes there.
@@ -359,11 +363,14 @@ class Slam {
       false;         ///< recent_scans_map_'s front is the previous frame's scan (not the whole map)
   int misfits_ = 0;  ///< misfit frames in a row
   /// How much consecutive scans cross each other's structure where the map registration
-  /// placed them, over the last frames it did (per frame: seen through, and seen through or
-  /// confirmed, both ways summed): the front-end's wrong points on this floor.
+  /// placed them, and how much a scan crosses the map's, over the last frames it did (per
+  /// frame: seen through, and seen through or confirmed; both ways summed for the scans): the
+  /// front-end's wrong points on this floor, and those the map has gathered as well.
   struct AgreementTally {
     int seen_through = 0;
     int informative = 0;
+    int map_seen_through = 0;
+    int map_informative = 0;
   };
   std::deque<AgreementTally> agreement_history_;
   bool doubt_ = false;        ///< a misfit came since the map was last matched: nothing joins the map
