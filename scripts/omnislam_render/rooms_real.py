@@ -116,9 +116,9 @@ def checker_room() -> Room:
 def building_real() -> Room:
     """A held-out scene (not bundled): the building floor with narrow light oak planks, a light
     skirting and ceiling panels (soft shadows) over the corridors and rooms."""
-    lamps = [AreaLamp((x, y, 2.9), (1.2, 0.3), 0.30) for x, y in
-             ((4.0, 1.0), (10.0, 1.0), (16.0, 1.0), (1.0, 8.0), (19.0, 8.0), (6.0, 8.0), (14.0, 8.0))]
-    room = _realistic(building_floor(), wood_planks(900.0, 120.0), lamps, None, (0.85, 0.85, 0.82))
+    floor = building_floor()
+    lamps = [AreaLamp((x, y, 2.9), (1.2, 0.3), 0.30) for (x, y, _), _ in floor.lights]  # where its lights are
+    room = _realistic(floor, wood_planks(900.0, 120.0), lamps, None, (0.85, 0.85, 0.82))
     room.name = "building-real"
     return room
 

@@ -278,10 +278,10 @@ class Room:
                 f"{vec(*_mm(*hi))} }} }} }}  // sun through {sun.window}")
 
     def _skirting_pov(self) -> list[str]:
+        # A board between each wall and its face (inner_faces(), in the same order as walls()).
         sk = self.skirting
-        inner = inset_outline(self.outline, sk.depth)
         out = []
-        for (x1, y1, x2, y2), (a1, b1, a2, b2) in zip(self.walls(), polygon_segments(inner)):
+        for (x1, y1, x2, y2), (a1, b1, a2, b2) in zip(self.walls(), self.inner_faces()):
             lo = (min(x1, x2, a1, a2), min(y1, y2, b1, b2), 0.0)
             hi = (max(x1, x2, a1, a2), max(y1, y2, b1, b2), sk.height)
             out.append(f"box {{ {vec(*_mm(*lo))}, {vec(*_mm(*hi))} pigment {{ {_rgb(sk.colour)} }} "
@@ -423,20 +423,6 @@ class Floor(Room):
         if self.skirting is None:
             return self.walls()
         return [_moved_left(segment, self.skirting.depth) for segment in self.walls()]
-
-    def _skirting_pov(self) -> list[str]:
-        # A board along every side of the free floor, on its free side (left of the segment);
-        # at a wall's end (a door's jamb) the jamb's own board meets it.
-        sk = self.skirting
-        out = []
-        for segment in self.walls():
-            x1, y1, x2, y2 = segment
-            a1, b1, a2, b2 = _moved_left(segment, sk.depth)
-            lo = (min(x1, x2, a1, a2), min(y1, y2, b1, b2), 0.0)
-            hi = (max(x1, x2, a1, a2), max(y1, y2, b1, b2), sk.height)
-            out.append(f"box {{ {vec(*_mm(*lo))}, {vec(*_mm(*hi))} pigment {{ {_rgb(sk.colour)} }} "
-                       f"{self.finish} }}  // skirting")
-        return out
 
     def _wall_boxes(self) -> list[str]:
         t = WALL_THICKNESS

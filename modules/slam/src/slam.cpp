@@ -554,12 +554,9 @@ bool Slam::count_misfit(const Points2 &scan_base, const FrameEstimate &estimate,
   // one way alone misses a carrying into a narrower place, whose near walls stand in the
   // other's free space but hide nothing of it. A scan point within two fusion radii of
   // structure is on it (the 0.1 m the relocaliser counts), a point stands for half a fusion
-  // radius either side (the map's spacing), and the scans' wrong points are what the
-  // scans of this run show where the map placed them (contradicts()).
-  const double margin_m = 2.0 * config_.map.fusion_radius_m, radius_m = 0.5 * config_.map.fusion_radius_m;
+  // radius either side (the map's spacing; agreement_with()), and the scans' wrong points
+  // are what the scans of this run show where the map placed them (contradicts()).
   const Points2 map_points = positions_of(map_.points());
-  const Points2 &previous_map = recent_scans_map_.front();
-  const Points2 previous_base = transformed(previous_map, previous_.T_map_base.inverse());
   auto consistent = [&](const Eigen::Isometry2d &T_map_base) {
     const Eigen::Isometry2d correction = predicted.inverse() * T_map_base;
     if (correction.translation().norm() > config_.max_correction_m ||
@@ -568,16 +565,13 @@ bool Slam::count_misfit(const Points2 &scan_base, const FrameEstimate &estimate,
     // A previous scan that was itself a misfit is no reference (taken from where no scan
     // agrees, or from inside a box in a synthetic test), nor is the whole map that stands in
     // for it after an operator's pose or a resume: the map alone judges.
-    const bool previous_agrees =
-        misfits_ > 0 || !previous_is_scan_ ||
-        (!contradicts(ray_agreement(scan_base, T_map_base, previous_map, margin_m, radius_m),
-                      Reference::kPreviousScan) &&
-         !contradicts(ray_agreement(previous_base, previous_.T_map_base, transformed(scan_base, T_map_base),
-                                    margin_m, radius_m),
-                      Reference::kPreviousScan));
-    return previous_agrees &&
-           !contradicts(ray_agreement(scan_base, T_map_base, map_points, margin_m, radius_m),
-                        Reference::kMap);
+    if (misfits_ == 0 && previous_is_scan_) {
+      const Agreements previous = agreement_with_previous(scan_base, T_map_base);
+      if (contradicts(previous.forward, Reference::kPreviousScan) ||
+          contradicts(previous.backward, Reference::kPreviousScan))
+        return false;
+    }
+    return !contradicts(agreement_with(scan_base, T_map_base, map_points), Reference::kMap);
   };
   const bool explained = consistent(estimate.T_map_base) || (map_fit_ && consistent(*map_fit_));
 
@@ -586,16 +580,27 @@ bool Slam::count_misfit(const Points2 &scan_base, const FrameEstimate &estimate,
   return doubt_;
 }
 
+Slam::Agreements Slam::agreement_with_previous(const Points2 &scan_base,
+                                               const Eigen::Isometry2d &T_map_base) const {
+  const Points2 &previous_map = recent_scans_map_.front();
+  return {agreement_with(scan_base, T_map_base, previous_map),
+          ray_agreement(transformed(previous_map, previous_.T_map_base.inverse()), previous_.T_map_base,
+                        transformed(scan_base, T_map_base), 2.0 * config_.map.fusion_radius_m,
+                        0.5 * config_.map.fusion_radius_m)};
+}
+
+RayAgreement Slam::agreement_with(const Points2 &scan_base, const Eigen::Isometry2d &T_map_base,
+                                  std::span<const Point2> map_points) const {
+  return ray_agreement(scan_base, T_map_base, map_points, 2.0 * config_.map.fusion_radius_m,
+                       0.5 * config_.map.fusion_radius_m);
+}
+
 void Slam::record_agreement(const Points2 &scan_base, const Eigen::Isometry2d &T_map_base) {
   if (!previous_is_scan_ || recent_scans_map_.empty()) return;
-  const double margin_m = 2.0 * config_.map.fusion_radius_m, radius_m = 0.5 * config_.map.fusion_radius_m;
-  const Points2 &previous_map = recent_scans_map_.front();
-  const RayAgreement forward = ray_agreement(scan_base, T_map_base, previous_map, margin_m, radius_m);
-  const RayAgreement backward =
-      ray_agreement(transformed(previous_map, previous_.T_map_base.inverse()), previous_.T_map_base,
-                    transformed(scan_base, T_map_base), margin_m, radius_m);
+  const Agreements previous = agreement_with_previous(scan_base, T_map_base);
   // The map around the scan: the registration's own index (bounded, whatever the map's size).
-  const RayAgreement on_map = ray_agreement(scan_base, T_map_base, map_.index().points(), margin_m, radius_m);
+  const RayAgreement on_map = agreement_with(scan_base, T_map_base, map_.index().points());
+  const RayAgreement &forward = previous.forward, &backward = previous.backward;
   agreement_history_.push_front(
       {forward.seen_through + backward.seen_through,
        forward.seen_through + forward.confirmed + backward.seen_through + backward.confirmed,

@@ -258,6 +258,17 @@ class Slam {
   /// frame must stay out of the map).
   [[nodiscard]] bool count_misfit(const Points2 &scan_base, const FrameEstimate &estimate,
                                   const Eigen::Isometry2d &predicted);
+  /// At the misfit test's margins (count_misfit): the scan at `T_map_base` against the
+  /// previous scan, each one's rays against the other's structure (forward: the scan's), and
+  /// the scan against `map_points`.
+  struct Agreements {
+    RayAgreement forward;
+    RayAgreement backward;
+  };
+  [[nodiscard]] Agreements agreement_with_previous(const Points2 &scan_base,
+                                                   const Eigen::Isometry2d &T_map_base) const;
+  [[nodiscard]] RayAgreement agreement_with(const Points2 &scan_base, const Eigen::Isometry2d &T_map_base,
+                                            std::span<const Point2> map_points) const;
   /// Records how much the scan of a frame the map registration placed and the previous scan
   /// contradict each other, and the scan and the map around it (the references count_misfit
   /// judges by).
