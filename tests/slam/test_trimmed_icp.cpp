@@ -130,6 +130,77 @@ TEST_CASE("trimmed ICP: a position prior holds the pose along a plain corridor, 
   CHECK(std::abs(free.T_model_sample.translation().y() - 0.05) < 0.005);
 }
 
+TEST_CASE("trimmed ICP: along a corridor slightly bent walls do not overrule the prior", "[slam][icp]") {
+  // The map of a plain corridor 2 m wide whose walls, from 1.5 m ahead, lean inward by 2 deg (a
+  // front-end bends a wall seen obliquely; one scan's bend joins the map while the next scan
+  // sees the wall straighter). Against their normals a shift along the corridor changes the
+  // residuals by 3.5% of it, so the fit slides the scan along it to cancel millimetres across
+  // it: the walls' millimetres divided by the lean. Those normals hold less than one pair's
+  // worth of information along the corridor, so the prior keeps the position there, and the
+  // covariance is the prior's.
+  std::mt19937_64 rng(11);
+  std::normal_distribution<double> noise(0.0, 0.001);
+  const double lean = std::tan(2.0 * std::numbers::pi / 180.0);
+  Points2 map;
+  for (double x = -3.0; x <= 3.3; x += 0.05) {
+    const double inward = x > 1.5 ? (x - 1.5) * lean : 0.0;
+    for (const double side : {-1.0, 1.0}) map.emplace_back(x, side * (1.0 - inward) + noise(rng));
+  }
+  const Eigen::Isometry2d truth = pose(0.3, 0.0, 0.0);
+  Points2 sample;
+  for (double x = -2.7; x <= 3.0; x += 0.05) {
+    for (const double y : {-1.0, 1.0})
+      sample.push_back(truth.inverse() * Eigen::Vector2d(0.3 + x, y + noise(rng)));
+  }
+  omnislam::slam::PosePrior prior;
+  prior.T_model_sample = truth;
+  const double sigma_m = 0.0144;  // 10% of a 0.25 m step / sqrt 3
+  prior.translation_covariance = Eigen::Matrix2d::Identity() * sigma_m * sigma_m;
+  omnislam::slam::TrimmedIcpConfig all_pairs;
+  all_pairs.min_constraining_pairs = 0.0;  // the behaviour before: every direction the pairs'
+  const auto held = register_trimmed_icp(NearestNeighbors(map), sample, truth, {}, &prior);
+  const auto pulled = register_trimmed_icp(NearestNeighbors(map), sample, truth, all_pairs, &prior);
+  REQUIRE(held.valid);
+  REQUIRE(pulled.valid);
+  INFO("x held " << held.T_model_sample.translation().x() << ", every direction the pairs' "
+                 << pulled.T_model_sample.translation().x());
+  CHECK(held.unconstrained_directions == 1);
+  CHECK(pulled.unconstrained_directions == 0);
+  CHECK(std::abs(held.T_model_sample.translation().x() - 0.3) < 0.001);
+  CHECK(std::abs(pulled.T_model_sample.translation().x() - 0.3) > 0.005);  // 10.6 mm
+  // Across the corridor and in heading the walls decide as before.
+  CHECK(std::abs(held.T_model_sample.translation().y()) < 0.002);
+  CHECK(std::abs(yaw_rad_of(held.T_model_sample)) < 0.001);
+  // Along it the covariance is the prior's.
+  CHECK(std::sqrt(held.robust_covariance(0, 0)) == Approx(sigma_m).epsilon(0.01));
+  CHECK(std::sqrt(held.robust_covariance(1, 1)) < 0.002);
+}
+
+TEST_CASE("trimmed ICP: with walls along both directions the pairs decide every direction, prior or not",
+          "[slam][icp]") {
+  const auto walls = omnislam::test::l_room();
+  std::mt19937_64 rng(13);
+  const Eigen::Isometry2d T_map_a = pose(1.0, 0.5, 0.0), T_map_b = pose(1.25, 0.6, 0.03);
+  const Points2 scan_a = omnislam::test::scan_from(walls, T_map_a, rng);
+  const Points2 scan_b = omnislam::test::scan_from(walls, T_map_b, rng);
+  const Eigen::Isometry2d truth = T_map_a.inverse() * T_map_b;
+  omnislam::slam::PosePrior prior;
+  prior.T_model_sample = truth * pose(0.02, -0.02, 0.0);
+  prior.translation_covariance = Eigen::Matrix2d::Identity() * 0.0144 * 0.0144;
+  omnislam::slam::TrimmedIcpConfig all_pairs;
+  all_pairs.min_constraining_pairs = 0.0;
+  const auto result =
+      register_trimmed_icp(NearestNeighbors(scan_a), scan_b, prior.T_model_sample, {}, &prior);
+  const auto before =
+      register_trimmed_icp(NearestNeighbors(scan_a), scan_b, prior.T_model_sample, all_pairs, &prior);
+  REQUIRE(result.valid);
+  CHECK(result.unconstrained_directions == 0);
+  CHECK((result.T_model_sample.matrix() - before.T_model_sample.matrix()).norm() ==
+        Approx(0.0).margin(1e-12));
+  CHECK((result.robust_covariance - before.robust_covariance).norm() == Approx(0.0).margin(1e-15));
+  CHECK((truth.inverse() * result.T_model_sample).translation().norm() < 0.01);
+}
+
 TEST_CASE("trimmed ICP: the cluster-robust covariance covers an error shared by a wall's points",
           "[slam][icp][covariance]") {
   // Two scans of the same room from the same place; in the sample every point beyond x > 2 m

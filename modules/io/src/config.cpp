@@ -262,6 +262,7 @@ void read_slam(YamlSection &section, slam::SlamConfig &slam) {
   section.read("covariance_sectors", slam.icp.covariance_sectors);
   section.read("range_weighting_passes", slam.icp.range_weighting_passes);
   section.read("residual_tail_dof", slam.icp.residual_tail_dof);
+  section.read("min_constraining_pairs", slam.icp.min_constraining_pairs);
   section.read("use_srel_test", slam.use_srel_test);
   section.read("srel_limit_percent", slam.srel_limit_percent);
   section.read("srel_relax_percent", slam.srel_relax_percent);
@@ -295,6 +296,8 @@ void read_slam(YamlSection &section, slam::SlamConfig &slam) {
     section.fail("range_weighting_passes", "must be in 0..10");
   if (!(slam.icp.residual_tail_dof >= 0.0 && std::isfinite(slam.icp.residual_tail_dof)))
     section.fail("residual_tail_dof", "must be >= 0 (0: Gaussian residuals)");
+  if (!(slam.icp.min_constraining_pairs >= 0.0 && std::isfinite(slam.icp.min_constraining_pairs)))
+    section.fail("min_constraining_pairs", "must be >= 0 (0: every direction the pairs' own)");
   if (slam.icp.max_iterations < 1 || slam.icp.max_iterations > 1000) {
     section.fail("max_iterations", "must be in 1..1000");
   }

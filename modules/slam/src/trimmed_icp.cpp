@@ -155,28 +155,80 @@ NormalEquations normal_equations(const std::vector<Pair> &pairs, const Motion &m
   return eq;
 }
 
+// The left motion (dx, dy, dyaw) about the map origin from the sample origin's own motion
+// u and the yaw: (dx, dy) = u - dyaw perp(t), t the sample origin in the model frame.
+Eigen::Matrix3d origin_from_sample_motion(const Motion &motion) {
+  const Eigen::Vector2d t = motion.T.translation();
+  Eigen::Matrix3d G = Eigen::Matrix3d::Identity();
+  G(0, 2) = t.y();
+  G(1, 2) = -t.x();
+  return G;
+}
+
+// The translations of the sample origin the pairs pin (TrimmedIcpConfig::min_constraining_pairs):
+// a projector on (u, yaw) that removes the directions of u with too little information, from
+// J^T J in those coordinates, whose translation block is sum w n n^T.
+struct Constrained {
+  Eigen::Matrix3d projector = Eigen::Matrix3d::Identity();
+  Eigen::Matrix2d removed = Eigen::Matrix2d::Zero();  ///< the projector onto the removed directions of u
+  int unconstrained = 0;
+};
+Constrained constrained_directions(const Eigen::Matrix3d &JtJ_sample, double min_pairs) {
+  Constrained result;
+  if (!(min_pairs > 0.0)) return result;
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> information(JtJ_sample.topLeftCorner<2, 2>());
+  for (int i = 0; i < 2; ++i) {
+    if (information.eigenvalues()(i) >= min_pairs) continue;
+    const Eigen::Vector2d v = information.eigenvectors().col(i);
+    result.removed += v * v.transpose();
+    ++result.unconstrained;
+  }
+  result.projector.topLeftCorner<2, 2>() -= result.removed;
+  return result;
+}
+
 Motion point_to_line_motion(const std::vector<Pair> &pairs, const Motion &current, const PosePrior *prior,
-                            double residual_variance_m2) {
+                            double residual_variance_m2, double min_constraining_pairs) {
   const NormalEquations eq = normal_equations(pairs, current);
   Eigen::Matrix3d A = eq.JtJ;
   Eigen::Vector3d b = -eq.Jtr;
+  const Eigen::Matrix3d G = origin_from_sample_motion(current);
   if (prior != nullptr) {
-    // The prior's residual, linearised in the left motion (dx, dy, dyaw) about the map
-    // origin: the sample origin t moves by (dx, dy) + dyaw * perp(t).
-    const Eigen::Vector2d t = current.T.translation();
-    Eigen::Matrix<double, 2, 3> H;
-    H << 1.0, 0.0, -t.y(), 0.0, 1.0, t.x();
+    // Solved for the sample origin's motion and the yaw: the prior is on that origin, and
+    // what the pairs do not pin of it is the prior's alone.
+    const Constrained kept = constrained_directions(G.transpose() * A * G, min_constraining_pairs);
+    A = kept.projector * G.transpose() * A * G * kept.projector / residual_variance_m2;
+    b = kept.projector * G.transpose() * b / residual_variance_m2;
     const Eigen::Matrix2d W = prior->translation_covariance.inverse();
-    const Eigen::Vector2d e = t - prior->T_model_sample.translation();
-    A = A / residual_variance_m2 + H.transpose() * W * H;
-    b = b / residual_variance_m2 - H.transpose() * W * e;
+    const Eigen::Vector2d e = current.T.translation() - prior->T_model_sample.translation();
+    A.topLeftCorner<2, 2>() += W;
+    b.head<2>() -= W * e;
   }
-  const Eigen::Vector3d delta = A.ldlt().solve(b);
+  Eigen::Vector3d delta = A.ldlt().solve(b);
+  if (prior != nullptr) delta = G * delta;
   if (!delta.allFinite()) return current;
   Eigen::Isometry2d step = Eigen::Isometry2d::Identity();
   step.linear() = Eigen::Rotation2Dd(delta.z()).toRotationMatrix();
   step.translation() = delta.head<2>();
   return {step * current.T, 1.0};
+}
+
+// A covariance of the left motion about the map origin with the prior's variance, and no
+// other, along the sample origin's translations the pairs leave to it; both parts apart.
+struct PriorAlong {
+  Eigen::Matrix3d pairs;  ///< what the pairs pin
+  Eigen::Matrix3d prior;  ///< the prior's along the rest
+  [[nodiscard]] Eigen::Matrix3d sum() const { return pairs + prior; }
+};
+PriorAlong with_prior_along(const Eigen::Matrix3d &covariance, const Motion &motion, const Constrained &kept,
+                            const PosePrior &prior) {
+  const Eigen::Matrix3d G = origin_from_sample_motion(motion);
+  const Eigen::Matrix3d G_inverse = G.inverse();
+  const Eigen::Matrix3d pinned =
+      kept.projector * G_inverse * covariance * G_inverse.transpose() * kept.projector;
+  Eigen::Matrix3d held = Eigen::Matrix3d::Zero();
+  held.topLeftCorner<2, 2>() = kept.removed * prior.translation_covariance * kept.removed;
+  return {G * pinned * G.transpose(), G * held * G.transpose()};
 }
 
 // e: the pairs' mean squared residual, each weighted (so with weights, the residual
@@ -376,7 +428,8 @@ Pass iterate(const NearestNeighbors &model, const Points2 &sample, const Motion 
       largest_sq = std::max(largest_sq, (current.apply(pair.sample) - pair.model).squaredNorm());
     search_radius = std::max(config.min_search_radius_m, std::sqrt(largest_sq));
     current = config.metric == IcpMetric::kPointToLine
-                  ? point_to_line_motion(pairs, current, prior, std::max(error, kMinResidualVarianceM2))
+                  ? point_to_line_motion(pairs, current, prior, std::max(error, kMinResidualVarianceM2),
+                                         config.min_constraining_pairs)
                   : horn_motion(pairs, config.estimate_scale);
   }
   if (best_pairs.empty()) return pass;
@@ -460,6 +513,22 @@ TrimmedIcpResult register_trimmed_icp(const NearestNeighbors &model, const Point
       robust_covariance_of(pass.pairs, returned, config.covariance_sectors, result.covariance);
   result.robust_covariance = robust.covariance;
   result.covariance_dof = robust.dof;
+  if (prior != nullptr && config.metric == IcpMetric::kPointToLine) {
+    const Eigen::Matrix3d G = origin_from_sample_motion(returned);
+    const Constrained kept = constrained_directions(
+        G.transpose() * normal_equations(pass.pairs, returned).JtJ * G, config.min_constraining_pairs);
+    result.unconstrained_directions = kept.unconstrained;
+    if (kept.unconstrained > 0) {
+      result.covariance = with_prior_along(result.covariance, returned, kept, *prior).sum();
+      const PriorAlong robust_parts = with_prior_along(result.robust_covariance, returned, kept, *prior);
+      result.robust_covariance = robust_parts.sum();
+      // The prior's part is a model's (infinitely many degrees of freedom): Welch and
+      // Satterthwaite over the two, sized by their position variance, as the SLAM's walk is.
+      const double pinned = robust_parts.pairs.topLeftCorner<2, 2>().trace();
+      const double total = result.robust_covariance.topLeftCorner<2, 2>().trace();
+      if (pinned > 0.0) result.covariance_dof *= (total * total) / (pinned * pinned);
+    }
+  }
   return result;
 }
 

@@ -50,6 +50,15 @@ struct TrimmedIcpConfig {
   /// squares, (nu + 3) (nu - 2) / ((nu + 1) nu) of the residual variance (nu > 2). 4: Lange,
   /// Little & Taylor's (1989) robust default; 0: Gaussian residuals (the behaviour before).
   double residual_tail_dof = 4.0;
+  /// With a pose prior (point-to-line only): a direction of the motion that the pairs pin
+  /// with less information than this many pairs whose normals lie along it (the smaller
+  /// eigenvalue of sum w n n^T, in pairs) is left to the prior, and the returned covariance
+  /// takes the prior's variance there. Along a plain corridor every normal lies across it,
+  /// and a degree of tilt in a few of them (a wall bent by its scan's errors, a skirting
+  /// board's top beside its base) would otherwise place the robot along the corridor by the
+  /// walls' millimetre residuals divided by that tilt, overruling the odometry. 3: as many
+  /// pairs as a planar pose has parameters (fewer never determine one). 0: off.
+  double min_constraining_pairs = 3.0;
 };
 
 struct TrimmedIcpResult {
@@ -79,6 +88,9 @@ struct TrimmedIcpResult {
   /// The range-noise model of the last reweighting pass, k / s0^2 in (px/m)^2: a pair's
   /// weight was 1 / (1 + range_noise_ratio b^2). 0 when the fit was unweighted.
   double range_noise_ratio = 0.0;
+  /// Directions of the translation left to the prior (TrimmedIcpConfig::min_constraining_pairs):
+  /// 0, 1 (a corridor) or 2.
+  int unconstrained_directions = 0;
 };
 
 /// Fewest degrees of freedom predictive_covariance assumes (a t with fewer has no variance).
