@@ -1,7 +1,10 @@
 #include "omnislam/slam/nearest_neighbors.hpp"
 
 #include <Eigen/Eigenvalues>
+#include <cmath>
 #include <nanoflann.hpp>
+#include <stdexcept>
+#include <string>
 #include <utility>
 
 namespace omnislam::slam {
@@ -30,11 +33,25 @@ NearestNeighbors::NearestNeighbors(Points2 points) : points_(std::move(points)) 
   if (!points_.empty()) index_ = std::make_unique<Index>(&points_);
 }
 
+NearestNeighbors::NearestNeighbors(Points2 points, std::vector<double> weights)
+    : NearestNeighbors(std::move(points)) {
+  if (weights.size() != points_.size()) {
+    throw std::invalid_argument("NearestNeighbors: " + std::to_string(weights.size()) + " weights for " +
+                                std::to_string(points_.size()) + " points");
+  }
+  for (const double w : weights) {
+    if (!(w > 0.0 && std::isfinite(w)))
+      throw std::invalid_argument("NearestNeighbors: a weight is not finite and positive");
+  }
+  weights_ = std::move(weights);
+}
+
 NearestNeighbors::~NearestNeighbors() = default;
 
 // A moved std::vector keeps its buffer, so the tree's pointer to points_ must follow it.
 NearestNeighbors::NearestNeighbors(NearestNeighbors &&other) noexcept
     : points_(std::move(other.points_)),
+      weights_(std::move(other.weights_)),
       index_(std::move(other.index_)),
       normals_(std::move(other.normals_)),
       normal_known_(std::move(other.normal_known_)) {
@@ -43,6 +60,7 @@ NearestNeighbors::NearestNeighbors(NearestNeighbors &&other) noexcept
 
 NearestNeighbors &NearestNeighbors::operator=(NearestNeighbors &&other) noexcept {
   points_ = std::move(other.points_);
+  weights_ = std::move(other.weights_);
   index_ = std::move(other.index_);
   normals_ = std::move(other.normals_);
   normal_known_ = std::move(other.normal_known_);
@@ -93,13 +111,22 @@ const Point2 &NearestNeighbors::normal(std::size_t index) const {
   params.sorted = false;
   index_->tree.radiusSearch(points_[index].data(), kNormalRadiusM * kNormalRadiusM, found, params);
   if (found.size() < 3) return normals_[index];
+  // Weighted by each point's inverse variance: a map point seen 30 times is a mean of 30
+  // observations, one seen 3 times (a skirting board's top taken now and then for the
+  // wall's base, 0.1 m behind it) is not, and would otherwise turn the wall's normals
+  // beside it by tens of degrees.
+  auto weight = [this](std::size_t i) { return weights_.empty() ? 1.0 : weights_[i]; };
   Point2 mean = Point2::Zero();
-  for (const auto &neighbor : found) mean += points_[neighbor.first];
-  mean /= static_cast<double>(found.size());
+  double total = 0.0;
+  for (const auto &neighbor : found) {
+    mean += weight(neighbor.first) * points_[neighbor.first];
+    total += weight(neighbor.first);
+  }
+  mean /= total;
   Eigen::Matrix2d scatter = Eigen::Matrix2d::Zero();
   for (const auto &neighbor : found) {
     const Point2 d = points_[neighbor.first] - mean;
-    scatter += d * d.transpose();
+    scatter += weight(neighbor.first) * d * d.transpose();
   }
   // Eigenvalues ascending: the first eigenvector is across the local line.
   const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> solver(scatter);

@@ -124,13 +124,15 @@ const NearestNeighbors &PointMap::index_near(const Points2 &points_map, double r
 
 void PointMap::index_points_in(const Box &region) {
   Points2 positions;
+  std::vector<double> hits;  // a point's weight in the normals: it is the mean of that many
   indexed_points_.clear();
   for (std::size_t i = 0; i < points_.size(); ++i) {
     if (!region.contains(points_[i].position_m)) continue;
     positions.push_back(points_[i].position_m);
+    hits.push_back(static_cast<double>(std::max(points_[i].hits, 1)));
     indexed_points_.push_back(i);
   }
-  index_ = NearestNeighbors(std::move(positions));
+  index_ = NearestNeighbors(std::move(positions), std::move(hits));
   indexed_ = region;
 }
 

@@ -27,6 +27,10 @@ inline constexpr double kNormalRadiusM = 0.15;
 class NearestNeighbors {
  public:
   explicit NearestNeighbors(Points2 points = {});
+  /// With a weight per point, its inverse variance up to a common factor (a map point fused
+  /// from n observations, their mean: n), so each normal is the weighted line fit.
+  /// std::invalid_argument unless there is one finite positive weight per point.
+  NearestNeighbors(Points2 points, std::vector<double> weights);
   ~NearestNeighbors();
   NearestNeighbors(NearestNeighbors &&) noexcept;
   NearestNeighbors &operator=(NearestNeighbors &&) noexcept;
@@ -36,8 +40,8 @@ class NearestNeighbors {
   [[nodiscard]] const Points2 &points() const { return points_; }
 
   /// Unit normal of the local line through point `index` (PCA of its neighbours within
-  /// kNormalRadiusM), or zero where fewer than 3 points lie there. Computed on first use and cached,
-  /// so a registration pays only for the points it pairs with.
+  /// kNormalRadiusM, weighted when the points are), or zero where fewer than 3 points lie there. Computed on
+  /// first use and cached, so a registration pays only for the points it pairs with.
   [[nodiscard]] const Point2 &normal(std::size_t index) const;
   [[nodiscard]] bool empty() const { return points_.empty(); }
 
@@ -53,6 +57,7 @@ class NearestNeighbors {
  private:
   struct Index;
   Points2 points_;
+  std::vector<double> weights_;  ///< empty: every point weighs 1
   std::unique_ptr<Index> index_;
   mutable Points2 normals_;
   mutable std::vector<bool> normal_known_;
