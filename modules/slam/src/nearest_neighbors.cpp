@@ -114,7 +114,7 @@ const Point2 &NearestNeighbors::normal(std::size_t index) const {
   // Weighted by each point's inverse variance: a map point seen 30 times is a mean of 30
   // observations, one seen 3 times (a skirting board's top taken now and then for the
   // wall's base, 0.1 m behind it) is not, and would otherwise turn the wall's normals
-  // beside it by tens of degrees.
+  // beside it by degrees, by tens where the wall has few points yet.
   auto weight = [this](std::size_t i) { return weights_.empty() ? 1.0 : weights_[i]; };
   Point2 mean = Point2::Zero();
   double total = 0.0;

@@ -40,8 +40,9 @@ class NearestNeighbors {
   [[nodiscard]] const Points2 &points() const { return points_; }
 
   /// Unit normal of the local line through point `index` (PCA of its neighbours within
-  /// kNormalRadiusM, weighted when the points are), or zero where fewer than 3 points lie there. Computed on
-  /// first use and cached, so a registration pays only for the points it pairs with.
+  /// kNormalRadiusM, weighted when the points are), or zero where fewer than 3 points lie
+  /// there. Computed on first use and cached, so a registration pays only for the points it
+  /// pairs with.
   [[nodiscard]] const Point2 &normal(std::size_t index) const;
   [[nodiscard]] bool empty() const { return points_.empty(); }
 
