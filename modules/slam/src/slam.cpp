@@ -584,9 +584,8 @@ Slam::Agreements Slam::agreement_with_previous(const Points2 &scan_base,
                                                const Eigen::Isometry2d &T_map_base) const {
   const Points2 &previous_map = recent_scans_map_.front();
   return {agreement_with(scan_base, T_map_base, previous_map),
-          ray_agreement(transformed(previous_map, previous_.T_map_base.inverse()), previous_.T_map_base,
-                        transformed(scan_base, T_map_base), 2.0 * config_.map.fusion_radius_m,
-                        0.5 * config_.map.fusion_radius_m)};
+          agreement_with(transformed(previous_map, previous_.T_map_base.inverse()), previous_.T_map_base,
+                         transformed(scan_base, T_map_base))};
 }
 
 RayAgreement Slam::agreement_with(const Points2 &scan_base, const Eigen::Isometry2d &T_map_base,
@@ -602,9 +601,9 @@ void Slam::record_agreement(const Points2 &scan_base, const Eigen::Isometry2d &T
   const RayAgreement on_map = agreement_with(scan_base, T_map_base, map_.index().points());
   const RayAgreement &forward = previous.forward, &backward = previous.backward;
   agreement_history_.push_front(
-      {forward.seen_through + backward.seen_through,
-       forward.seen_through + forward.confirmed + backward.seen_through + backward.confirmed,
-       on_map.seen_through, on_map.seen_through + on_map.confirmed});
+      {{forward.seen_through + backward.seen_through,
+        forward.seen_through + forward.confirmed + backward.seen_through + backward.confirmed},
+       {on_map.seen_through, on_map.seen_through + on_map.confirmed}});
   if (agreement_history_.size() > kAgreementFrames) agreement_history_.pop_back();
 }
 
@@ -614,11 +613,10 @@ bool Slam::contradicts(const RayAgreement &agreement, Reference reference) const
   // at the relocaliser's correlation (neighbours share errors). A misfit lies beyond three
   // standard deviations of that, and beyond the relocaliser's outlier share. Against the map
   // the share is the map's own: it also holds the wrong points of every scan it fused.
-  const bool map = reference == Reference::kMap;
   double seen = 0.0, informative = 0.0;
   for (const AgreementTally &tally : agreement_history_) {
-    seen += map ? tally.map_seen_through : tally.seen_through;
-    informative += map ? tally.map_informative : tally.informative;
+    seen += tally.against(reference).seen_through;
+    informative += tally.against(reference).informative;
   }
   const double n = agreement.confirmed + agreement.seen_through;
   if (n <= 0.0) return false;

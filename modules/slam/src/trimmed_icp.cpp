@@ -169,9 +169,13 @@ Eigen::Matrix3d origin_from_sample_motion(const Motion &motion) {
 // a projector on (u, yaw) that removes the directions of u with too little information, from
 // J^T J in those coordinates, whose translation block is sum w n n^T.
 struct Constrained {
-  Eigen::Matrix3d projector = Eigen::Matrix3d::Identity();
   Eigen::Matrix2d removed = Eigen::Matrix2d::Zero();  ///< the projector onto the removed directions of u
   int unconstrained = 0;
+  [[nodiscard]] Eigen::Matrix3d projector() const {
+    Eigen::Matrix3d kept = Eigen::Matrix3d::Identity();
+    kept.topLeftCorner<2, 2>() -= removed;
+    return kept;
+  }
 };
 Constrained constrained_directions(const Eigen::Matrix3d &JtJ_sample, double min_pairs) {
   Constrained result;
@@ -183,29 +187,29 @@ Constrained constrained_directions(const Eigen::Matrix3d &JtJ_sample, double min
     result.removed += v * v.transpose();
     ++result.unconstrained;
   }
-  result.projector.topLeftCorner<2, 2>() -= result.removed;
   return result;
 }
 
 Motion point_to_line_motion(const std::vector<Pair> &pairs, const Motion &current, const PosePrior *prior,
                             double residual_variance_m2, double min_constraining_pairs) {
   const NormalEquations eq = normal_equations(pairs, current);
-  Eigen::Matrix3d A = eq.JtJ;
-  Eigen::Vector3d b = -eq.Jtr;
-  const Eigen::Matrix3d G = origin_from_sample_motion(current);
-  if (prior != nullptr) {
+  Eigen::Vector3d delta;
+  if (prior == nullptr) {
+    delta = eq.JtJ.ldlt().solve(-eq.Jtr);
+  } else {
     // Solved for the sample origin's motion and the yaw: the prior is on that origin, and
     // what the pairs do not pin of it is the prior's alone.
-    const Constrained kept = constrained_directions(G.transpose() * A * G, min_constraining_pairs);
-    A = kept.projector * G.transpose() * A * G * kept.projector / residual_variance_m2;
-    b = kept.projector * G.transpose() * b / residual_variance_m2;
+    const Eigen::Matrix3d G = origin_from_sample_motion(current);
+    const Eigen::Matrix3d JtJ_sample = G.transpose() * eq.JtJ * G;
+    const Eigen::Matrix3d P = constrained_directions(JtJ_sample, min_constraining_pairs).projector();
+    Eigen::Matrix3d A = P * JtJ_sample * P / residual_variance_m2;
+    Eigen::Vector3d b = -P * G.transpose() * eq.Jtr / residual_variance_m2;
     const Eigen::Matrix2d W = prior->translation_covariance.inverse();
     const Eigen::Vector2d e = current.T.translation() - prior->T_model_sample.translation();
     A.topLeftCorner<2, 2>() += W;
     b.head<2>() -= W * e;
+    delta = G * A.ldlt().solve(b);
   }
-  Eigen::Vector3d delta = A.ldlt().solve(b);
-  if (prior != nullptr) delta = G * delta;
   if (!delta.allFinite()) return current;
   Eigen::Isometry2d step = Eigen::Isometry2d::Identity();
   step.linear() = Eigen::Rotation2Dd(delta.z()).toRotationMatrix();
@@ -224,8 +228,8 @@ PriorAlong with_prior_along(const Eigen::Matrix3d &covariance, const Motion &mot
                             const PosePrior &prior) {
   const Eigen::Matrix3d G = origin_from_sample_motion(motion);
   const Eigen::Matrix3d G_inverse = G.inverse();
-  const Eigen::Matrix3d pinned =
-      kept.projector * G_inverse * covariance * G_inverse.transpose() * kept.projector;
+  const Eigen::Matrix3d P = kept.projector();
+  const Eigen::Matrix3d pinned = P * G_inverse * covariance * G_inverse.transpose() * P;
   Eigen::Matrix3d held = Eigen::Matrix3d::Zero();
   held.topLeftCorner<2, 2>() = kept.removed * prior.translation_covariance * kept.removed;
   return {G * pinned * G.transpose(), G * held * G.transpose()};

@@ -377,11 +377,16 @@ class Slam {
   /// placed them, and how much a scan crosses the map's, over the last frames it did (per
   /// frame: seen through, and seen through or confirmed; both ways summed for the scans): the
   /// front-end's wrong points on this floor, and those the map has gathered as well.
-  struct AgreementTally {
+  struct Share {
     int seen_through = 0;
     int informative = 0;
-    int map_seen_through = 0;
-    int map_informative = 0;
+  };
+  struct AgreementTally {
+    Share previous_scan;  ///< both ways summed
+    Share map;
+    [[nodiscard]] const Share &against(Reference reference) const {
+      return reference == Reference::kMap ? map : previous_scan;
+    }
   };
   std::deque<AgreementTally> agreement_history_;
   bool doubt_ = false;        ///< a misfit came since the map was last matched: nothing joins the map
