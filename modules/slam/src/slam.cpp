@@ -1,4 +1,7 @@
 #include "omnislam/slam/slam.hpp"
+
+#include <Eigen/Eigenvalues>
+
 #include "omnislam/slam/planar_pose.hpp"
 #include "omnislam/slam/ray_agreement.hpp"
 
@@ -16,6 +19,8 @@ namespace {
 constexpr std::size_t kAgreementFrames = 20;
 // A misfit's share of crossing points lies this many standard deviations beyond theirs.
 constexpr double kMisfitSigmas = 3.0;
+// The 99.9% quantile of chi-square with three degrees of freedom (x, y, yaw).
+constexpr double kChiSquare999ThreeDof = 16.27;
 
 // Odometry uncertainty of one step, used to grow the covariance of unregistered frames
 // (the thesis noise model: 10% of the distance, 1.5 deg of heading).
@@ -104,7 +109,6 @@ bool Slam::accept(const TrimmedIcpResult &registration, const Eigen::Isometry2d 
       std::abs(yaw_rad_of(correction)) > config_.max_correction_rad)
     return false;
   if (!config_.odometry_gate || !predicted_by_odometry_) return true;
-  constexpr double kChiSquare999ThreeDof = 16.27;
   Eigen::Matrix3d S = prediction_covariance_;
   S(0, 0) += registration.final_error_m2;
   S(1, 1) += registration.final_error_m2;
@@ -503,8 +507,9 @@ FrameEstimate Slam::process(const Points2 &scan_base, const std::optional<Eigen:
       walk_dof_before_lost_ = walk_dof_;
       search_map();
       unmatched_m_ = 0.0;
+      carried_ = false;
     }
-    const LocalizationResult found = relocalizer_->process(scan_base, T_odom_base);
+    const LocalizationResult found = search_step(scan_base, T_odom_base, predicted, step);
     if (found.state == LocalizationState::kLocalized) {
       // Confirmed on the map: where the tracking is (which drifted meanwhile, placed by
       // scan-to-scan registration alone) or elsewhere (carried there).
@@ -631,12 +636,41 @@ void Slam::search_map() {
   relocalizer_ = std::make_unique<Relocalizer>(positions_of(map_.points()), config_.relocalizer);
 }
 
+bool Slam::breaks_with_previous(const Points2 &scan_base, const Eigen::Isometry2d &predicted) const {
+  if (!predicted_by_odometry_ || !previous_is_scan_ || recent_scans_map_.empty()) return true;
+  const TrimmedIcpResult fit =
+      register_trimmed_icp(NearestNeighbors(recent_scans_map_.front()), scan_base, predicted, config_.icp);
+  const Eigen::Isometry2d correction = predicted.inverse() * fit.T_model_sample;
+  return !fit.valid || correction.translation().norm() > config_.max_correction_m ||
+         std::abs(yaw_rad_of(correction)) > config_.max_correction_rad ||
+         std::sqrt(fit.final_error_m2) > config_.max_rms_m;
+}
+
+LocalizationResult Slam::search_step(const Points2 &scan_base,
+                                     const std::optional<Eigen::Isometry2d> &T_odom_base,
+                                     const Eigen::Isometry2d &predicted, const Eigen::Isometry2d &step) {
+  carried_ = carried_ || breaks_with_previous(scan_base, predicted);
+  if (carried_) return relocalizer_->process(scan_base, T_odom_base);
+  const Eigen::Matrix3d grown = predictive_covariance(
+      carried(walk_covariance_, previous_.T_map_base, predicted) +
+          rotated_covariance(odometry_step_covariance(step), previous_.T_map_base.linear()),
+      walk_dof_);
+  const double position_variance =
+      Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(grown.topLeftCorner<2, 2>()).eigenvalues().maxCoeff();
+  SearchWindow window;
+  window.T_map_base = predicted;
+  window.radius_m = std::max(std::sqrt(kChiSquare999ThreeDof * position_variance), config_.max_correction_m);
+  window.half_angle_rad = std::min(
+      std::numbers::pi, std::max(std::sqrt(kChiSquare999ThreeDof * grown(2, 2)), config_.max_correction_rad));
+  return relocalizer_->process(scan_base, T_odom_base, window);
+}
+
 FrameEstimate Slam::search_lost(const Points2 &scan_base, const std::optional<Eigen::Isometry2d> &T_odom_base,
                                 const Eigen::Isometry2d &predicted, const Eigen::Isometry2d &step) {
   FrameEstimate estimate;
   estimate.T_map_base = predicted;  // dead reckoning from the last tracked frame
   estimate.lost = true;
-  const LocalizationResult found = relocalizer_->process(scan_base, T_odom_base);
+  const LocalizationResult found = search_step(scan_base, T_odom_base, predicted, step);
   if (found.state == LocalizationState::kLocalized) return found_again(scan_base, T_odom_base, found);
   estimate.covariance = published_covariance(estimate, frame_term(estimate, step), false);
   return finish_frame(estimate, scan_base, T_odom_base, false);

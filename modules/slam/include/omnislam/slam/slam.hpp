@@ -281,6 +281,19 @@ class Slam {
   [[nodiscard]] bool contradicts(const RayAgreement &agreement, Reference reference) const;
   /// Starts (or, on a corrected map, restarts) the search of the whole map for the robot.
   void search_map();
+  /// Whether the scan breaks with the previous frame's where the odometry puts it: it does
+  /// not register onto that scan within a frame's largest accepted correction and residual
+  /// (a carrying; also a view blocked right in front of the camera, where searching the
+  /// whole map is the safe reading). A doorway's parallax does not: the scans still fit.
+  [[nodiscard]] bool breaks_with_previous(const Points2 &scan_base, const Eigen::Isometry2d &predicted) const;
+  /// One frame of the search (in doubt or lost): the whole map once the robot may have been
+  /// carried (carried_), else the poses dead reckoning can have reached from the last
+  /// tracked one: the published uncertainty grown by this step, to chi-square 99.9% with
+  /// three degrees of freedom, and never less than a frame's largest accepted correction.
+  [[nodiscard]] LocalizationResult search_step(const Points2 &scan_base,
+                                               const std::optional<Eigen::Isometry2d> &T_odom_base,
+                                               const Eigen::Isometry2d &predicted,
+                                               const Eigen::Isometry2d &step);
   /// A lost frame: searched for on the map; when found, tracking resumes there.
   [[nodiscard]] FrameEstimate search_lost(const Points2 &scan_base,
                                           const std::optional<Eigen::Isometry2d> &T_odom_base,
@@ -396,6 +409,12 @@ class Slam {
   /// In doubt or lost: the search over the map as it was when the doubt began.
   std::unique_ptr<Relocalizer> relocalizer_;
   bool lost_ = false;
+  /// Since the doubt began, a scan broke with the one before it where the odometry put it
+  /// (or a frame came without odometry): the robot may have been carried anywhere, and the
+  /// whole map is searched. Until then the search keeps to where dead reckoning can have
+  /// taken it: a place the map has not seen can look like one it has (a corridor like
+  /// another), and only the track tells them apart.
+  bool carried_ = false;
   /// The frames since the doubt began (in doubt, then lost) that had odometry: their
   /// trajectory index and odometry pose. Dead-reckoned from before the carrying while they
   /// happen; when the search finds the robot, placed back from the found pose by their
