@@ -2,6 +2,7 @@
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <limits>
+#include <numbers>
 #include <random>
 #include <utility>
 #include <vector>
@@ -199,6 +200,30 @@ TEST_CASE("trimmed ICP: with walls along both directions the pairs decide every 
         Approx(0.0).margin(1e-12));
   CHECK((result.robust_covariance - before.robust_covariance).norm() == Approx(0.0).margin(1e-15));
   CHECK((truth.inverse() * result.T_model_sample).translation().norm() < 0.01);
+}
+
+TEST_CASE(
+    "trimmed ICP: a prior of an exact odometry step (standing still) holds the position, the yaw is fitted",
+    "[slam][icp]") {
+  // Standing, the thesis odometry model gives a step with no translation variance. Its
+  // inverse was infinite, the step undefined, and the registration returned where it
+  // started, in yaw too: a heading 1.5 deg off stayed off for as long as the robot stood.
+  const auto walls = omnislam::test::l_room();
+  std::mt19937_64 rng(17);
+  const Eigen::Isometry2d T_map = pose(1.0, 0.5, 0.2);
+  const Points2 map = omnislam::test::scan_from(walls, T_map, rng);
+  const Points2 scan = omnislam::test::scan_from(walls, T_map, rng);
+  omnislam::slam::PosePrior prior;
+  prior.T_model_sample = pose(0.0, 0.0, 1.5 * std::numbers::pi / 180.0);  // the truth is the identity
+  prior.translation_covariance.setZero();
+  const auto result = register_trimmed_icp(NearestNeighbors(map), scan, prior.T_model_sample, {}, &prior);
+  REQUIRE(result.valid);
+  INFO("yaw " << yaw_rad_of(result.T_model_sample) * 180.0 / std::numbers::pi << " deg, position "
+              << result.T_model_sample.translation().transpose());
+  CHECK(result.T_model_sample.matrix().allFinite());
+  CHECK(std::abs(yaw_rad_of(result.T_model_sample)) < 0.1 * std::numbers::pi / 180.0);
+  // The position stays within a few millimetres of the prior's (a millimetre's variance).
+  CHECK(result.T_model_sample.translation().norm() < 0.005);
 }
 
 TEST_CASE("trimmed ICP: the cluster-robust covariance covers an error shared by a wall's points",

@@ -14,8 +14,17 @@ namespace {
 
 constexpr double kInlierDistanceM = 0.1;
 // The pairs' residual variance is floored (an exact fit must not give them infinite weight
-// against a prior): a millimetre, well below any range noise.
+// against a prior): a millimetre, well below any range noise. The prior's translation
+// variance is floored alike: an exact odometry step (the robot standing, its wheels still)
+// must not give the prior infinite weight, whose inverse would leave the step undefined and
+// the registration frozen where it started, in yaw too.
 constexpr double kMinResidualVarianceM2 = 1e-6;
+
+Eigen::Matrix2d prior_information(const Eigen::Matrix2d &translation_covariance) {
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> axes(translation_covariance);
+  const Eigen::Vector2d floored = axes.eigenvalues().cwiseMax(kMinResidualVarianceM2);
+  return axes.eigenvectors() * floored.cwiseInverse().asDiagonal() * axes.eigenvectors().transpose();
+}
 
 struct Pair {
   Point2 model;
@@ -204,7 +213,7 @@ Motion point_to_line_motion(const std::vector<Pair> &pairs, const Motion &curren
     const Eigen::Matrix3d P = constrained_directions(JtJ_sample, min_constraining_pairs).projector();
     Eigen::Matrix3d A = P * JtJ_sample * P / residual_variance_m2;
     Eigen::Vector3d b = -P * G.transpose() * eq.Jtr / residual_variance_m2;
-    const Eigen::Matrix2d W = prior->translation_covariance.inverse();
+    const Eigen::Matrix2d W = prior_information(prior->translation_covariance);
     const Eigen::Vector2d e = current.T.translation() - prior->T_model_sample.translation();
     A.topLeftCorner<2, 2>() += W;
     b.head<2>() -= W * e;
