@@ -507,7 +507,7 @@ FrameEstimate Slam::process(const Points2 &scan_base, const std::optional<Eigen:
       walk_dof_before_lost_ = walk_dof_;
       search_map();
       unmatched_m_ = 0.0;
-      carried_ = false;
+      broke_with_previous_ = false;
     }
     const LocalizationResult found = search_step(scan_base, T_odom_base, predicted, step);
     if (found.state == LocalizationState::kLocalized) {
@@ -649,8 +649,8 @@ bool Slam::breaks_with_previous(const Points2 &scan_base, const Eigen::Isometry2
 LocalizationResult Slam::search_step(const Points2 &scan_base,
                                      const std::optional<Eigen::Isometry2d> &T_odom_base,
                                      const Eigen::Isometry2d &predicted, const Eigen::Isometry2d &step) {
-  carried_ = carried_ || breaks_with_previous(scan_base, predicted);
-  if (carried_) return relocalizer_->process(scan_base, T_odom_base);
+  broke_with_previous_ = broke_with_previous_ || breaks_with_previous(scan_base, predicted);
+  if (broke_with_previous_) return relocalizer_->process(scan_base, T_odom_base);
   const Eigen::Matrix3d grown = predictive_covariance(
       carried(walk_covariance_, previous_.T_map_base, predicted) +
           rotated_covariance(odometry_step_covariance(step), previous_.T_map_base.linear()),

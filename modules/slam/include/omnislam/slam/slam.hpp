@@ -287,7 +287,7 @@ class Slam {
   /// whole map is the safe reading). A doorway's parallax does not: the scans still fit.
   [[nodiscard]] bool breaks_with_previous(const Points2 &scan_base, const Eigen::Isometry2d &predicted) const;
   /// One frame of the search (in doubt or lost): the whole map once the robot may have been
-  /// carried (carried_), else the poses dead reckoning can have reached from the last
+  /// carried (broke_with_previous_), else the poses dead reckoning can have reached from the last
   /// tracked one: the published uncertainty grown by this step, to chi-square 99.9% with
   /// three degrees of freedom, and never less than a frame's largest accepted correction.
   [[nodiscard]] LocalizationResult search_step(const Points2 &scan_base,
@@ -414,7 +414,7 @@ class Slam {
   /// whole map is searched. Until then the search keeps to where dead reckoning can have
   /// taken it: a place the map has not seen can look like one it has (a corridor like
   /// another), and only the track tells them apart.
-  bool carried_ = false;
+  bool broke_with_previous_ = false;
   /// The frames since the doubt began (in doubt, then lost) that had odometry: their
   /// trajectory index and odometry pose. Dead-reckoned from before the carrying while they
   /// happen; when the search finds the robot, placed back from the found pose by their
