@@ -98,17 +98,21 @@ Eigen::Matrix3d Slam::frame_term(const FrameEstimate &estimate, const Eigen::Iso
              : rotated_covariance(odometry_step_covariance(step), previous_.T_map_base.linear());
 }
 
+bool Slam::within_correction(const Eigen::Isometry2d &predicted, const Eigen::Isometry2d &estimate) const {
+  const Eigen::Isometry2d correction = predicted.inverse() * estimate;
+  return correction.translation().norm() <= config_.max_correction_m &&
+         std::abs(yaw_rad_of(correction)) <= config_.max_correction_rad;
+}
+
 bool Slam::accept(const TrimmedIcpResult &registration, const Eigen::Isometry2d &predicted,
                   const Eigen::Isometry2d &estimate, double srel_limit_percent) const {
   if (!registration.valid) return false;
   if (config_.use_srel_test && registration.srel_percent >= srel_limit_percent) return false;
   if (std::sqrt(registration.final_error_m2) > config_.max_rms_m) return false;
   if (registration.inlier_share < config_.min_inlier_share) return false;
-  const Eigen::Isometry2d correction = predicted.inverse() * estimate;
-  if (correction.translation().norm() > config_.max_correction_m ||
-      std::abs(yaw_rad_of(correction)) > config_.max_correction_rad)
-    return false;
+  if (!within_correction(predicted, estimate)) return false;
   if (!config_.odometry_gate || !predicted_by_odometry_) return true;
+  const Eigen::Isometry2d correction = predicted.inverse() * estimate;
   Eigen::Matrix3d S = prediction_covariance_;
   S(0, 0) += registration.final_error_m2;
   S(1, 1) += registration.final_error_m2;
@@ -563,10 +567,7 @@ bool Slam::count_misfit(const Points2 &scan_base, const FrameEstimate &estimate,
   // are what the scans of this run show where the map placed them (contradicts()).
   const Points2 map_points = positions_of(map_.points());
   auto consistent = [&](const Eigen::Isometry2d &T_map_base) {
-    const Eigen::Isometry2d correction = predicted.inverse() * T_map_base;
-    if (correction.translation().norm() > config_.max_correction_m ||
-        std::abs(yaw_rad_of(correction)) > config_.max_correction_rad)
-      return false;
+    if (!within_correction(predicted, T_map_base)) return false;
     // A previous scan that was itself a misfit is no reference (taken from where no scan
     // agrees, or from inside a box in a synthetic test), nor is the whole map that stands in
     // for it after an operator's pose or a resume: the map alone judges.
@@ -640,9 +641,7 @@ bool Slam::breaks_with_previous(const Points2 &scan_base, const Eigen::Isometry2
   if (!predicted_by_odometry_ || !previous_is_scan_ || recent_scans_map_.empty()) return true;
   const TrimmedIcpResult fit =
       register_trimmed_icp(NearestNeighbors(recent_scans_map_.front()), scan_base, predicted, config_.icp);
-  const Eigen::Isometry2d correction = predicted.inverse() * fit.T_model_sample;
-  return !fit.valid || correction.translation().norm() > config_.max_correction_m ||
-         std::abs(yaw_rad_of(correction)) > config_.max_correction_rad ||
+  return !fit.valid || !within_correction(predicted, fit.T_model_sample) ||
          std::sqrt(fit.final_error_m2) > config_.max_rms_m;
 }
 
@@ -651,9 +650,9 @@ LocalizationResult Slam::search_step(const Points2 &scan_base,
                                      const Eigen::Isometry2d &predicted, const Eigen::Isometry2d &step) {
   broke_with_previous_ = broke_with_previous_ || breaks_with_previous(scan_base, predicted);
   if (broke_with_previous_) return relocalizer_->process(scan_base, T_odom_base);
+  // This frame as published when nothing places it: the walk carried here plus the step's.
   const Eigen::Matrix3d grown = predictive_covariance(
-      carried(walk_covariance_, previous_.T_map_base, predicted) +
-          rotated_covariance(odometry_step_covariance(step), previous_.T_map_base.linear()),
+      carried(walk_covariance_, previous_.T_map_base, predicted) + frame_term(FrameEstimate{}, step),
       walk_dof_);
   const double position_variance =
       Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(grown.topLeftCorner<2, 2>()).eigenvalues().maxCoeff();

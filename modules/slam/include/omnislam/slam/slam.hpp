@@ -307,6 +307,10 @@ class Slam {
   [[nodiscard]] FrameEstimate finish_frame(FrameEstimate estimate, const Points2 &scan_base,
                                            const std::optional<Eigen::Isometry2d> &T_odom_base,
                                            bool in_graph);
+  /// Whether `estimate` lies within the largest correction a frame may take from `predicted`
+  /// (SlamConfig::max_correction_m, max_correction_rad).
+  [[nodiscard]] bool within_correction(const Eigen::Isometry2d &predicted,
+                                       const Eigen::Isometry2d &estimate) const;
   [[nodiscard]] bool accept_without_odometry(const TrimmedIcpResult &registration,
                                              const Eigen::Isometry2d &predicted,
                                              const Eigen::Isometry2d &estimate) const;
