@@ -18,7 +18,7 @@ from . import odometry as odo
 from . import pov
 from .geometry import Pose, compose, inverse, relative_to_first, write_tum, read_tum
 from .rooms import building_floor, l_room, sim_room
-from .rooms_real import building_real, checker_room, l_room_real, office_real, sim_room_real
+from .rooms_real import building_real, checker_room, l_room_real, office_real, polished_room, sim_room_real
 from .scene import Room, frame_scene
 
 TRAJECTORIES_CSV = Path(__file__).resolve().parent / "data" / "trajectories.csv"
@@ -154,6 +154,9 @@ HELD_OUT: dict[str, DatasetSpec] = {
     "building-real": DatasetSpec("building-real", building_real, building_loop, False,
                                  "held out: building-2laps with oak planks and ceiling panels, camera 0.9 m",
                                  camera_height_m=0.9, grey=True),
+    "polished-room": DatasetSpec("polished-room", polished_room, lambda: facing_travel(table_points("3.2")), False,
+                                 "held out: sim-room path facing travel, polished vinyl mirroring the walls",
+                                 grey=True),
 }
 
 
