@@ -185,6 +185,8 @@ def dataset_yaml(spec: DatasetSpec, frames: int, origin: Pose, key: str, rig: M.
         f"name: {spec.name}\n"
         f"camera: {{width: {M.IMAGE_PX}, height: {M.IMAGE_PX}, center_px: [{rig.center_px[0]}, {rig.center_px[1]}], "
         f"focal_mm: {M.FOCAL_MM}, pixel_pitch_mm: {_fmt(M.PIXEL_MM)}{rig.yaml_fields()}}}\n"
+        + (f"# support rod: azimuth {rig.rod_azimuth_deg!r} deg, {rig.rod_diameter_mm!r} mm thick, its axis "
+           f"{pov.ROD_AXIS_RADIUS_MM!r} mm from the mirror's axis\n" if rig.rod_azimuth_deg is not None else "") +
         "mirror: thesis-2008          # mirror.md, derived constants\n"
         f"camera_height_m: {spec.camera_height_m}         # height of the camera pinhole F0 above the floor\n"
         f"frames: {frames}\n"

@@ -154,6 +154,11 @@ class Rig:
     tilt_deg: tuple[float, float] = (0.0, 0.0)
     offset_mm: tuple[float, float] = (0.0, 0.0)
     center_px: tuple[float, float] = (CENTER_PX, CENTER_PX)
+    # A support rod holding the mirror (the thesis's rig had one, "haste de suporte"): a
+    # vertical cylinder beside the mirror's rim at this robot-frame azimuth (deg), seen by
+    # both lobes, never by the camera directly. Not part of the camera model: no config key.
+    rod_azimuth_deg: float | None = None
+    rod_diameter_mm: float = 10.0
 
     def nominal(self) -> bool:
         return self == Rig()

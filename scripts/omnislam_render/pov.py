@@ -8,6 +8,7 @@ checked against the convention-check reference render.
 """
 from __future__ import annotations
 
+import math
 import shutil
 import subprocess
 import time
@@ -96,6 +97,7 @@ def mirror_block(rig: M.Rig = M.Rig()) -> str:
         + "// Black cap above the mirror: camera rays that miss both lobes end here.\n"
         "disc { <0,0,440>, -z, 400 pigment { rgb 0 } finish { ambient 0 diffuse 0 } no_shadow }\n"
     )
+    body += rod_block(rig)
     if rig.mirror_moved():
         # The lobes are cut (clipped) in the mirror's own frame, so the whole part moves.
         body = ("// The mirror as mounted: tilted and shifted (issue 12, mirror.Rig).\n"
@@ -106,6 +108,24 @@ def mirror_block(rig: M.Rig = M.Rig()) -> str:
         "  finish { ambient 0 diffuse 0 specular 0 phong 0 reflection { 1 } } }\n"
         + body
     )
+
+
+# Where the support rod stands: its axis 15 mm outside the mirror's rim (60 mm), from the
+# robot's top plate below the camera to the cap above the mirror; dull grey metal.
+ROD_AXIS_RADIUS_MM = 75.0
+ROD_Z_MM = (-150.0, 440.0)
+
+
+def rod_block(rig: M.Rig) -> str:
+    """The rig's support rod (rig.rod_azimuth_deg), fixed to the camera: it does not move
+    with the room, so every frame shows it at the same place."""
+    if rig.rod_azimuth_deg is None:
+        return ""
+    a = math.radians(rig.rod_azimuth_deg)
+    x, y = ROD_AXIS_RADIUS_MM * math.cos(a), ROD_AXIS_RADIUS_MM * math.sin(a)
+    return (f"// Support rod at azimuth {num(rig.rod_azimuth_deg)} deg, {num(rig.rod_diameter_mm)} mm thick.\n"
+            f"cylinder {{ {vec(x, y, ROD_Z_MM[0])}, {vec(x, y, ROD_Z_MM[1])}, {num(rig.rod_diameter_mm / 2)}\n"
+            "  pigment { rgb <0.45, 0.45, 0.47> } finish { ambient 0.1 diffuse 0.6 specular 0.4 roughness 0.02 } }\n")
 
 
 def povray_binary(wait_s: float = 600.0) -> str:
