@@ -19,7 +19,7 @@ from . import pov
 from .geometry import Pose, compose, inverse, relative_to_first, write_tum, read_tum
 from .rooms import building_floor, l_room, sim_room
 from .rooms_real import building_real, checker_room, l_room_real, office_real, polished_room, sim_room_real
-from .scene import Room, frame_scene
+from .scene import Room, frame_scene, person_pov
 
 TRAJECTORIES_CSV = Path(__file__).resolve().parent / "data" / "trajectories.csv"
 RATE_HZ = 10
@@ -73,6 +73,12 @@ class DatasetSpec:
     description: str
     camera_height_m: float = CAMERA_HEIGHT_M
     grey: bool = False      # store 8-bit grey PNGs (a third of the size; the front-end reads grey)
+    # People in the room, frame by frame: (frame index from 1, the robot's world poses) ->
+    # each person's (x, y, heading) in the room frame. Not in the floor plan (they move).
+    people: Callable[[int, Sequence[Pose]], list[Pose]] | None = None
+
+    def placements(self, world: Sequence[Pose]) -> list[list[Pose]]:
+        return [self.people(i, world) if self.people else [] for i in range(1, len(world) + 1)]
 
 
 def _still(points) -> list[Pose]:
@@ -144,6 +150,24 @@ DATASETS: dict[str, DatasetSpec] = {
 }
 
 
+def _people_in_sim_room(frame: int, world: Sequence[Pose]) -> list[Pose]:
+    """Three people in sim-room (its path, table 3.2): one following the robot five frames
+    (1.25 m) behind on its path from frame 6, one pacing back and forth in front of the
+    cabinet by the bottom wall (0.3 m a frame), one standing by the left cabinet until frame
+    20 and then gone (left the room)."""
+    out: list[Pose] = []
+    if frame >= 6:
+        (x0, y0, _), (x1, y1, _) = world[frame - 6], world[frame - 5]
+        out.append((x0, y0, math.atan2(y1 - y0, x1 - x0)))
+    lo, hi, step = -1.0, 0.8, 0.3
+    travel = ((frame - 1) * step) % (2.0 * (hi - lo))
+    forward = travel <= hi - lo
+    out.append((lo + travel if forward else hi - (travel - (hi - lo)), -1.45, 0.0 if forward else math.pi))
+    if frame <= 20:
+        out.append((-2.0, 1.1, -math.pi / 2))
+    return out
+
+
 # Held-out scenes: rendered on demand (`scripts/render-dataset NAME --out DIR`), never bundled
 # nor used to choose a parameter; they check that what works on the bundled datasets is not
 # tuned to them (README, "Scenes not bundled").
@@ -154,6 +178,9 @@ HELD_OUT: dict[str, DatasetSpec] = {
     "building-real": DatasetSpec("building-real", building_real, building_loop, False,
                                  "held out: building-2laps with oak planks and ceiling panels, camera 0.9 m",
                                  camera_height_m=0.9, grey=True),
+    "people-room": DatasetSpec("people-room", sim_room_real, lambda: _still(table_points("3.2")), True,
+                               "held out: sim-room-37-real with three people, one following the robot",
+                               grey=True, people=_people_in_sim_room),
     "polished-room": DatasetSpec("polished-room", polished_room, lambda: facing_travel(table_points("3.2")), False,
                                  "held out: sim-room path facing travel, polished vinyl mirroring the walls",
                                  grey=True),
@@ -166,9 +193,11 @@ def spec_of(name: str) -> DatasetSpec:
 
 
 def render_key(room: Room, camera_height_m: float = CAMERA_HEIGHT_M, grey: bool = False,
-               rig: M.Rig = M.Rig()) -> str:
+               rig: M.Rig = M.Rig(), people: Sequence[Sequence[Pose]] = ()) -> str:
     parts = [RENDERER_VERSION, room.pov_body(), pov.camera_block(rig), pov.mirror_block(rig), ANTIALIAS,
              repr(camera_height_m)]
+    if any(people):
+        parts.append(repr([[tuple(round(v, 6) for v in p) for p in frame] for frame in people]))
     text = "|".join(parts + (["grey"] if grey else []))
     return hashlib.sha256(text.encode()).hexdigest()[:16]
 
@@ -231,7 +260,7 @@ def write_metadata(spec: DatasetSpec, out: Path, frames: int | None = None, rig:
     elif (out / "odometry.txt").exists():
         (out / "odometry.txt").unlink()
     write_floorplan(out / "floorplan.csv", room, origin)
-    key = render_key(room, spec.camera_height_m, spec.grey, rig)
+    key = render_key(room, spec.camera_height_m, spec.grey, rig, spec.placements(world))
     (out / "dataset.yaml").write_text(dataset_yaml(spec, len(world), origin, key, rig))
     return world
 
@@ -280,13 +309,15 @@ def _link_or_copy(src: Path, dst: Path) -> None:
 def render_images(spec: DatasetSpec, out: Path, world: Sequence[Pose], threads: int = 2,
                   log=print, rig: M.Rig = M.Rig()) -> dict:
     room = spec.room()
-    key = render_key(room, spec.camera_height_m, spec.grey, rig)
+    people = spec.placements(world)
+    key = render_key(room, spec.camera_height_m, spec.grey, rig, people)
     images = out / "images"
     images.mkdir(parents=True, exist_ok=True)
     for stale in images.glob("*.png"):
         if not re.fullmatch(r"\d{6}", stale.stem) or int(stale.stem) > len(world):
             stale.unlink()
-    reuse = _reusable_images(out, key)
+    # A frame with people is its own: the same pose elsewhere in the run shows them elsewhere.
+    reuse = {} if any(people) else _reusable_images(out, key)
     done: dict[tuple, Path] = {}
     camera, mirror = pov.camera_block(rig), pov.mirror_block(rig)
     times, reused = [], 0
@@ -294,13 +325,14 @@ def render_images(spec: DatasetSpec, out: Path, world: Sequence[Pose], threads: 
         for i, pose in enumerate(world, start=1):
             dst = images / f"{i:06d}.png"
             pk = _pose_key(pose)
-            src = done.get(pk) or reuse.get(pk)
+            src = None if any(people) else done.get(pk) or reuse.get(pk)
             if src is not None:
                 _link_or_copy(src, dst)
                 reused += 1
             else:
                 pov_file = Path(tmp) / f"{i:06d}.pov"
-                pov_file.write_text(frame_scene(room, pose, spec.camera_height_m, camera, mirror))
+                extra = "\n  ".join(person_pov(*p) for p in people[i - 1])
+                pov_file.write_text(frame_scene(room, pose, spec.camera_height_m, camera, mirror, extra))
                 png_tmp = Path(tmp) / f"{i:06d}.png"
                 times.append(pov.render(pov_file, png_tmp, threads=threads, antialias=ANTIALIAS,
                                         grey=spec.grey))

@@ -328,12 +328,26 @@ def world_to_camera_matrix(pose: Pose, camera_height_m: float) -> str:
     return "matrix " + vec(*m)
 
 
-def frame_scene(room: Room, pose: Pose, camera_height_m: float, camera: str, mirror: str) -> str:
+def person_pov(x: float, y: float, heading: float, colour: Colour = (0.22, 0.24, 0.30)) -> str:
+    """A standing or walking person at (x, y) in the room frame (m), facing `heading` (rad):
+    two legs 0.85 m high 0.2 m apart, a torso to 1.45 m, a head; dark clothes."""
+    lx, ly = -math.sin(heading) * 0.1, math.cos(heading) * 0.1  # half the stance, sideways
+    legs = [Cylinder(f"leg {k}", (x + sign * lx, y + sign * ly), 0.06, 0.0, 0.85, colour)
+            for k, sign in enumerate((-1.0, 1.0))]
+    torso = Cylinder("torso", (x, y), 0.17, 0.85, 1.45, colour)
+    head = f"sphere {{ {vec(*_mm(x, y, 1.6))}, 100 pigment {{ rgb <0.55, 0.42, 0.35> }} {MATT} }}  // head"
+    return "\n  ".join([*(c.pov() for c in (*legs, torso)), head])
+
+
+def frame_scene(room: Room, pose: Pose, camera_height_m: float, camera: str, mirror: str,
+                extra: str = "") -> str:
+    """One frame: the room (and `extra`, objects of this frame alone in room coordinates, mm)
+    moved into the camera frame of the robot at `pose`."""
     return (
         "#version 3.7;\n"
         "global_settings { assumed_gamma 1.0 ambient_light rgb 1 max_trace_level 5 }\n"
         f"// room {room.name}, robot pose x={pose[0]!r} m y={pose[1]!r} m yaw={pose[2]!r} rad\n"
-        "union {\n  " + room.pov_body() + "\n"
+        "union {\n  " + room.pov_body() + ("\n  " + extra if extra else "") + "\n"
         f"  {world_to_camera_matrix(pose, camera_height_m)}\n}}\n"
         + camera + mirror
     )
