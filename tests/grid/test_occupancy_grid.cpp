@@ -82,3 +82,52 @@ TEST_CASE("occupancy grid: seeded from a trinary image (a resumed snapshot) give
   for (int i = 0; i < 3; ++i) resumed.add_scan(pose, std::vector<Ray>{{0.0, kNaN, 1.5}});
   CHECK(at(resumed.image(), wall.x(), wall.y()) == 100);
 }
+
+TEST_CASE(
+    "occupancy grid: floor seen under a table's edge does not clear it once two viewpoints saw the edge",
+    "[grid]") {
+  // A table's edge at (2.05, 0.05), seen from (0, 0) and from 0.5 m along it; then the robot
+  // drives round and sees the floor beyond it, under the table, eight times from (0, 0) (two
+  // hits, +0.85 each, need seven misses of -0.41 to read free).
+  const Eigen::Isometry2d here = Eigen::Translation2d(0.0, 0.05) * Eigen::Rotation2Dd(0.0);
+  const Eigen::Isometry2d along = Eigen::Translation2d(0.0, 0.55) * Eigen::Rotation2Dd(0.0);
+  const double to_edge_along = std::hypot(2.05, 0.5);
+  const Ray edge_here{0.0, 2.05, 2.05, true};
+  const Ray edge_along{std::atan2(-0.5, 2.05), to_edge_along, to_edge_along, true};
+  const Ray floor_under{0.0, kNaN, 3.0};
+  const auto seen_under = [&](OccupancyGrid &grid) {
+    for (int i = 0; i < 8; ++i) grid.add_scan(here, std::vector<Ray>{floor_under});
+  };
+  SECTION("from two viewpoints 0.5 m apart: it stays, the floor before and beyond it is free") {
+    OccupancyGrid grid({.resolution_m = 0.1});
+    grid.add_scan(here, std::vector<Ray>{edge_here});
+    grid.add_scan(along, std::vector<Ray>{edge_along});
+    seen_under(grid);
+    const GridImage image = grid.image();
+    CHECK(at(image, 2.05, 0.05) == 100);
+    CHECK(at(image, 1.05, 0.05) == 0);
+    CHECK(at(image, 2.55, 0.05) == 0);
+  }
+  SECTION("the floor seen under it before it was seen counts neither") {
+    OccupancyGrid grid({.resolution_m = 0.1});
+    seen_under(grid);
+    grid.add_scan(here, std::vector<Ray>{edge_here});
+    grid.add_scan(along, std::vector<Ray>{edge_along});
+    CHECK(at(grid.image(), 2.05, 0.05) == 100);
+  }
+  SECTION("from one viewpoint only (a wrong point that moves with the robot): cleared like any") {
+    OccupancyGrid grid({.resolution_m = 0.1});
+    grid.add_scan(here, std::vector<Ray>{edge_here});
+    grid.add_scan(here, std::vector<Ray>{edge_here});
+    seen_under(grid);
+    CHECK(at(grid.image(), 2.05, 0.05) == 0);
+  }
+  SECTION(
+      "a boundary on the floor (a wall's base, a person's feet) is cleared when the floor is seen there") {
+    OccupancyGrid grid({.resolution_m = 0.1});
+    grid.add_scan(here, std::vector<Ray>{{0.0, 2.05, 2.05, false}});
+    grid.add_scan(along, std::vector<Ray>{{edge_along.azimuth_rad, to_edge_along, to_edge_along, false}});
+    seen_under(grid);
+    CHECK(at(grid.image(), 2.05, 0.05) == 0);
+  }
+}

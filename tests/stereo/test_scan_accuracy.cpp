@@ -257,3 +257,37 @@ TEST_CASE("l-room-1lap-real: range per pixel of floor contacts and of stereo poi
   CHECK(far > 4.0 * near);
   CHECK(stereo_2_3 > 4.0 * contact_2_3);
 }
+
+TEST_CASE("l-room-1lap-real: edges above the floor are marked elevated, floor contacts never, however ranged",
+          "[stereo][floor][dataset]") {
+  // The occupancy grid keeps what was seen above the floor against floor seen under it
+  // (grid/occupancy_grid.hpp), so the flag must follow the search's decision, not the range's
+  // source: with floor contacts ranged by stereo they are still on the floor.
+  const omnislam::test::TruthDataset data =
+      omnislam::test::load_truth_dataset(dataset_dir("l-room-1lap-real"));
+  for (const bool floor_plane : {true, false}) {
+    omnislam::stereo::ScanConfig config = scan_config_of(data);
+    config.stereo.floor.floor_plane_range = floor_plane;
+    omnislam::stereo::ScanReconstructor reconstructor(config);
+    int elevated = 0, above = 0, tables = 0, contacts = 0;
+    for (std::size_t i = 0; i < data.images.size(); i += 10) {
+      for (const omnislam::stereo::ScanPoint &point : reconstructor.reconstruct(data.images[i]).points) {
+        if (point.floor_ranged) CHECK_FALSE(point.elevated);
+        if (point.elevated) {
+          ++elevated;
+          above += point.z_m > 0.04 ? 1 : 0;                     // the skirting's top is 0.08 m up
+          tables += point.z_m > 0.6 && point.z_m < 0.9 ? 1 : 0;  // the tables' tops 0.75 m
+        } else {
+          ++contacts;
+          CHECK(std::abs(point.z_m) < 0.1);
+        }
+      }
+    }
+    INFO("floor-plane range " << floor_plane << ": " << elevated << " elevated (" << above << " above 4 cm, "
+                              << tables << " at the tables' height), " << contacts << " on the floor");
+    CHECK(elevated > 300);
+    CHECK(above >= 0.99 * elevated);
+    CHECK(tables > 300);
+    CHECK(contacts > 300);
+  }
+}

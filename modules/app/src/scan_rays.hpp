@@ -25,7 +25,10 @@ namespace omnislam::app {
   }
   for (const stereo::ScanPoint &point : scan.points) {
     grid::Ray &ray = rays[static_cast<std::size_t>(point.column)];
-    if (!std::isfinite(ray.hit_m) || point.range_m < ray.hit_m) ray.hit_m = point.range_m;
+    if (!std::isfinite(ray.hit_m) || point.range_m < ray.hit_m) {
+      ray.hit_m = point.range_m;
+      ray.hit_elevated = point.elevated;
+    }
   }
   return rays;
 }

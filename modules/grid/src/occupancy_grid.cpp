@@ -52,7 +52,8 @@ void OccupancyGrid::mark_free(const Eigen::Vector2d &from_m, const Eigen::Vector
     delta[axis] = step[axis] != 0 ? std::abs(1.0 / direction[axis]) : std::numeric_limits<double>::infinity();
   }
   while (cell != last) {
-    update(cell, miss_);
+    const auto elevated = elevated_.find(key(cell));
+    if (elevated == elevated_.end() || !elevated->second.confirmed) update(cell, miss_);
     const int axis = next.x() < next.y() ? 0 : 1;
     if (next[axis] > 1.0) break;  // the end lies in this cell after all (rounding)
     cell[axis] += step[axis];
@@ -70,7 +71,19 @@ void OccupancyGrid::add_scan(const Eigen::Isometry2d &T_map_base, std::span<cons
     double free_m = std::isfinite(ray.free_m) ? ray.free_m : 0.0;
     if (hit) free_m = std::min(free_m, ray.hit_m);
     if (free_m > 0.0) mark_free(origin, origin + free_m * direction);
-    if (hit) update(cell_of(origin + ray.hit_m * direction), hit_);
+    if (!hit) continue;
+    const Cell cell = cell_of(origin + ray.hit_m * direction);
+    if (ray.hit_elevated) {
+      const auto [elevated, first] = elevated_.try_emplace(key(cell), Elevated{origin.cast<float>()});
+      if (!first && !elevated->second.confirmed &&
+          (origin.cast<float>() - elevated->second.first_seen_from_m).norm() >= config_.elevated_baseline_m) {
+        elevated->second.confirmed = true;
+        // The floor seen under it before said nothing about it.
+        float &value = log_odds_[key(cell)];
+        value = std::max(value, 0.0f);
+      }
+    }
+    update(cell, hit_);
   }
 }
 

@@ -533,7 +533,8 @@ BoundaryStats FloorBoundaryFinder::find(const FloorGeometry &geometry, const cv:
         const auto stereo = triangulator.triangulate(column, edge.row_subpx, match->row_subpx);
         if (!stereo) continue;
         ++stats.elevated;
-        points.push_back({column, edge.row_subpx, match->row_subpx, stereo->range_m, stereo->height_m});
+        points.push_back(
+            {column, edge.row_subpx, match->row_subpx, stereo->range_m, stereo->height_m, false, true});
         boundary_m = static_cast<float>(stereo->range_m);
         break;
       }
@@ -607,7 +608,8 @@ BoundaryStats FloorBoundaryFinder::find(const FloorGeometry &geometry, const cv:
         const auto stereo = triangulator.triangulate(column, high.row_subpx, high_match->row_subpx);
         if (stereo && stereo->range_m < point.range_m) {
           ++stats.elevated;
-          point = {column, high.row_subpx, high_match->row_subpx, stereo->range_m, stereo->height_m};
+          point = {column, high.row_subpx, high_match->row_subpx, stereo->range_m, stereo->height_m, false,
+                   true};
         }
       }
       points.push_back(point);

@@ -189,7 +189,7 @@ double ScanReconstructor::floor_range_per_px(float inner_row) const {
 }
 
 void ScanReconstructor::add_point(int column, double range_m, double height_m, float inner_row,
-                                  float outer_row, bool floor_ranged, LocalScan &scan) {
+                                  float outer_row, bool floor_ranged, bool elevated, LocalScan &scan) {
   if (range_m < config_.stereo.near_cutoff_m || range_m > config_.stereo.far_cutoff_m) {
     ++scan.stats.outside_cutoffs;
     return;
@@ -199,7 +199,7 @@ void ScanReconstructor::add_point(int column, double range_m, double height_m, f
   const auto c = static_cast<std::size_t>(column);
   scan.points.push_back({column_azimuth_rad_[c], range_m, range_m * column_cos_[c], range_m * column_sin_[c],
                          config_.camera_height_m + height_m, inner_row, outer_row, column,
-                         static_cast<float>(range_per_px_m), floor_ranged});
+                         static_cast<float>(range_per_px_m), floor_ranged, elevated});
 }
 
 void ScanReconstructor::build_boundary_scan(LocalScan &scan) {
@@ -214,7 +214,7 @@ void ScanReconstructor::build_boundary_scan(LocalScan &scan) {
   scan.stats.twin_spread_px = boundary_stats_.twin_spread_px;
   for (const BoundaryPoint &point : boundary_points_) {
     add_point(point.column, point.range_m, point.height_m, point.inner_row, point.outer_row,
-              point.floor_ranged, scan);
+              point.floor_ranged, point.elevated, scan);
   }
   // One boundary per column already; the per-degree filter matters only for finer panoramas.
   if (config_.stereo.one_point_per_degree)
@@ -233,7 +233,8 @@ void ScanReconstructor::build_scan(const std::vector<RowMatch> &matches, LocalSc
       ++scan.stats.no_intersection;
       continue;
     }
-    add_point(match.column, point->range_m, point->height_m, match.inner_row, match.outer_row, false, scan);
+    add_point(match.column, point->range_m, point->height_m, match.inner_row, match.outer_row, false, false,
+              scan);
   }
   if (stereo.one_point_per_degree) scan.stats.filtered_out = keep_nearest_per_degree(scan.points, filtered_);
   scan.stats.points = static_cast<int>(scan.points.size());

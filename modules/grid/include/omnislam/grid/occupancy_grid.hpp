@@ -10,6 +10,15 @@
 /// An occupancy grid from local scans (issue 14): each ray marks the cells it crosses as
 /// free up to how far the floor was seen to be free, and the cell of its boundary point as
 /// occupied, in log-odds (the usual inverse sensor model). The grid grows with what is seen.
+///
+/// The free floor is seen at floor level, under (or over) whatever stands above it: a cell
+/// where something above the floor was seen (a table's or a desk's edge, a low box's top) is
+/// not cleared by floor seen under or beyond it, before or after (it is an obstacle to a
+/// robot as tall as the camera; the rays under a desk see its floor, not its top), once two
+/// viewpoints at least `elevated_baseline_m` apart have seen it there: a thing in the room
+/// stays where it is when the robot moves, a wrong match that moves with the robot (a
+/// reflection, a texture read as a step) does not. Other cells, where the floor itself ended
+/// (a wall's base, a leg, a person's feet), are cleared by floor seen through them later.
 
 namespace omnislam::grid {
 
@@ -24,14 +33,20 @@ struct GridConfig {
   /// Trinary cells (nav2 map_server's defaults): occupied at or above, free at or below.
   double occupied_threshold = 0.65;
   double free_threshold = 0.25;
+  /// Viewpoints this far apart must both see something above the floor in a cell before floor
+  /// seen under it stops clearing it: five cells, so that a wrong point carried along with the
+  /// robot lands in another cell from the second viewpoint.
+  double elevated_baseline_m = 0.25;
 };
 
 /// One ray of a scan in the robot frame: a boundary at hit_m (NaN: none found) and free floor
-/// up to free_m (NaN: unknown).
+/// up to free_m (NaN: unknown). `hit_elevated`: the boundary is something above the floor (a
+/// table's edge, a shelf), not where something stands on it.
 struct Ray {
   double azimuth_rad = 0.0;
   double hit_m = 0.0;
   double free_m = 0.0;
+  bool hit_elevated = false;
 };
 
 /// The grid as nav_msgs/OccupancyGrid lays it out: row-major from the cell at `origin_m`
@@ -74,6 +89,13 @@ class OccupancyGrid {
   GridConfig config_;
   float hit_ = 0.0f, miss_ = 0.0f, min_ = 0.0f, max_ = 0.0f;
   std::unordered_map<std::uint64_t, float> log_odds_;
+  /// Cells where something above the floor was seen: from where first, and whether a second
+  /// viewpoint elevated_baseline_m away confirmed it.
+  struct Elevated {
+    Eigen::Vector2f first_seen_from_m;
+    bool confirmed = false;
+  };
+  std::unordered_map<std::uint64_t, Elevated> elevated_;
 };
 
 }  // namespace omnislam::grid

@@ -46,6 +46,7 @@ class TrajectoryGrid {
  private:
   struct KeptRay {
     float azimuth_rad, hit_m, free_m;
+    bool hit_elevated;
   };
   struct KeptScan {
     int trajectory_index = -1;

@@ -65,6 +65,7 @@ struct BoundaryPoint {
   double range_m = 0.0;
   double height_m = 0.0;      ///< relative to the pinhole (the floor is -camera_height_m for a contact)
   bool floor_ranged = false;  ///< ranged from the floor plane (inner row only), not by stereo
+  bool elevated = false;      ///< an edge above the floor (step 2 or 5), not a floor contact
 };
 
 struct BoundaryStats {

@@ -25,6 +25,10 @@ struct ScanPoint {
   float range_per_px_m = 0.0f;
   /// Ranged from the floor plane at the inner row (a floor contact), not by stereo.
   bool floor_ranged = false;
+  /// An edge found above the floor (a table's edge, a shelf), not where something stands on
+  /// it: floor seen beyond or under it does not contradict it (grid/occupancy_grid.hpp). The
+  /// thesis's nearest-edge matcher does not tell: false.
+  bool elevated = false;
 };
 
 /// Counts after each step of the reconstruction, for logs, profiles and tests.

@@ -78,7 +78,7 @@ class ScanReconstructor {
   /// Adds the point unless outside the cut-offs, with its range per pixel (of the floor
   /// plane's range when `floor_ranged`, else of the stereo range).
   void add_point(int column, double range_m, double height_m, float inner_row, float outer_row,
-                 bool floor_ranged, LocalScan &scan);
+                 bool floor_ranged, bool elevated, LocalScan &scan);
   /// ScanPoint::range_per_px_m of a stereo point: the range's central difference over one
   /// pixel of each row (one-sided where the other side loses the intersection), combined
   /// as independent errors; infinite when neither side of a row intersects.
