@@ -18,7 +18,8 @@ from . import odometry as odo
 from . import pov
 from .geometry import Pose, compose, inverse, relative_to_first, write_tum, read_tum
 from .rooms import building_floor, l_room, sim_room
-from .rooms_real import building_real, checker_room, l_room_real, office_real, polished_room, sim_room_real
+from .rooms_real import (building_real, checker_room, l_room_real, office_real, polished_building, polished_room,
+                         sim_room_real)
 from .scene import Room, frame_scene, person_pov
 
 TRAJECTORIES_CSV = Path(__file__).resolve().parent / "data" / "trajectories.csv"
@@ -181,6 +182,9 @@ HELD_OUT: dict[str, DatasetSpec] = {
     "people-room": DatasetSpec("people-room", sim_room_real, lambda: _still(table_points("3.2")), True,
                                "held out: sim-room-37-real with three people, one following the robot",
                                grey=True, people=_people_in_sim_room),
+    "polished-building": DatasetSpec("polished-building", polished_building, building_loop, False,
+                                     "held out: building-2laps on polished vinyl mirroring its corridors",
+                                     grey=True),
     "polished-room": DatasetSpec("polished-room", polished_room, lambda: facing_travel(table_points("3.2")), False,
                                  "held out: sim-room path facing travel, polished vinyl mirroring the walls",
                                  grey=True),

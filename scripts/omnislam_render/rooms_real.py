@@ -141,6 +141,17 @@ def polished_room() -> Room:
     return room
 
 
+def polished_building() -> Room:
+    """A held-out scene (not bundled): the building floor on polished vinyl that mirrors its
+    walls (long corridors: grazing angles, where Fresnel's reflection is strongest), a dark
+    skirting and ceiling panels over the corridors and rooms."""
+    floor = building_floor()
+    lamps = [AreaLamp((x, y, 2.9), (1.2, 0.3), 0.30) for (x, y, _), _ in floor.lights]
+    room = _realistic(floor, polished_vinyl(), lamps, None, (0.18, 0.18, 0.20))
+    room.name = "polished-building"
+    return room
+
+
 def building_real() -> Room:
     """A held-out scene (not bundled): the building floor with narrow light oak planks, a light
     skirting and ceiling panels (soft shadows) over the corridors and rooms."""
