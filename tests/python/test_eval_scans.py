@@ -27,12 +27,15 @@ def test_scan_csv_says_how_each_point_was_ranged():
     assert result.returncode == 0, result.stderr
     rows = list(csv.DictReader(io.StringIO(result.stdout)))
     assert rows and list(rows[0]) == ["azimuth_deg", "range_m", "x_m", "y_m", "z_m", "inner_row", "outer_row",
-                                      "floor_ranged", "range_per_px_m"]
+                                      "floor_ranged", "range_per_px_m", "elevated"]
     kinds = {row["floor_ranged"] for row in rows}
     assert kinds == {"0", "1"}  # the room's walls give floor contacts, its tables stereo points
     for row in rows:
         if row["floor_ranged"] == "1":
             assert abs(float(row["z_m"])) < 1e-9  # a floor contact lies on the floor
+            assert row["elevated"] == "0"
+        else:  # the floor boundary's stereo points are the edges it found above the floor
+            assert row["elevated"] == "1" and float(row["z_m"]) > 0.04
         assert float(row["range_per_px_m"]) > 0.0
 
 

@@ -24,11 +24,11 @@ struct ScanOptions {
 };
 
 void print_csv(const stereo::LocalScan &scan) {
-  std::printf("azimuth_deg,range_m,x_m,y_m,z_m,inner_row,outer_row,floor_ranged,range_per_px_m\n");
+  std::printf("azimuth_deg,range_m,x_m,y_m,z_m,inner_row,outer_row,floor_ranged,range_per_px_m,elevated\n");
   for (const stereo::ScanPoint &p : scan.points) {
-    std::printf("%.3f,%.4f,%.4f,%.4f,%.4f,%.3f,%.3f,%d,%.5f\n", p.azimuth_rad * kDegPerRad, p.range_m, p.x_m,
-                p.y_m, p.z_m, static_cast<double>(p.inner_row), static_cast<double>(p.outer_row),
-                p.floor_ranged ? 1 : 0, p.range_per_px_m);
+    std::printf("%.3f,%.4f,%.4f,%.4f,%.4f,%.3f,%.3f,%d,%.5f,%d\n", p.azimuth_rad * kDegPerRad, p.range_m,
+                p.x_m, p.y_m, p.z_m, static_cast<double>(p.inner_row), static_cast<double>(p.outer_row),
+                p.floor_ranged ? 1 : 0, p.range_per_px_m, p.elevated ? 1 : 0);
   }
 }
 
