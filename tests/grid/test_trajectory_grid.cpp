@@ -131,3 +131,31 @@ TEST_CASE("trajectory grid: a seed from a snapshot stays under every rebuild", "
   CHECK(image.cells[static_cast<std::size_t>(y * image.width + x)] == 100);
   CHECK(image.cells[static_cast<std::size_t>(y * image.width + x + 1)] == 0);
 }
+
+TEST_CASE("trajectory grid: an edge seen above the floor stays through a rebuild", "[grid]") {
+  // A table's edge at (1.025, 0.025) seen from (0, 0) and from 0.5 m beside, then the floor
+  // under it seen eight times from farther back, each scan its own frame.
+  TrajectoryGrid grid;
+  std::vector<Eigen::Isometry2d> trajectory = {pose(0.0, 0.0, 0.0), pose(0.0, 0.5, 0.0)};
+  const Eigen::Vector2d edge(1.025, 0.025);
+  for (int frame = 0; frame < 2; ++frame) {
+    const Eigen::Vector2d to_edge = edge - trajectory[static_cast<std::size_t>(frame)].translation();
+    REQUIRE(grid.add_scan(
+        frame, trajectory[static_cast<std::size_t>(frame)],
+        std::vector<Ray>{{std::atan2(to_edge.y(), to_edge.x()), to_edge.norm(), to_edge.norm(), true}}));
+  }
+  for (int frame = 2; frame < 10; ++frame) {
+    trajectory.push_back(pose(-0.1 * frame, 0.025, 0.0));
+    REQUIRE(grid.add_scan(frame, trajectory.back(), std::vector<Ray>{{0.0, NAN, 1.8 + 0.1 * frame, false}}));
+  }
+  const auto cell = [](const GridImage &image, const Eigen::Vector2d &at) {
+    const int x = static_cast<int>(std::floor((at.x() - image.origin_m.x()) / image.resolution_m));
+    const int y = static_cast<int>(std::floor((at.y() - image.origin_m.y()) / image.resolution_m));
+    return image.cells[static_cast<std::size_t>(y * image.width + x)];
+  };
+  CHECK(cell(grid.image(), edge) == 100);
+  CHECK(cell(grid.image(), Eigen::Vector2d(1.325, 0.025)) == 0);  // the floor under and beyond it
+  grid.rebuild(trajectory);
+  CHECK(cell(grid.image(), edge) == 100);
+  CHECK(cell(grid.image(), Eigen::Vector2d(1.325, 0.025)) == 0);
+}
