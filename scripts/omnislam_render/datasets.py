@@ -321,7 +321,8 @@ def render_images(spec: DatasetSpec, out: Path, world: Sequence[Pose], threads: 
         if not re.fullmatch(r"\d{6}", stale.stem) or int(stale.stem) > len(world):
             stale.unlink()
     # A frame with people is its own: the same pose elsewhere in the run shows them elsewhere.
-    reuse = {} if any(people) else _reusable_images(out, key)
+    own_frames = any(people)
+    reuse = {} if own_frames else _reusable_images(out, key)
     done: dict[tuple, Path] = {}
     camera, mirror = pov.camera_block(rig), pov.mirror_block(rig)
     times, reused = [], 0
@@ -329,7 +330,7 @@ def render_images(spec: DatasetSpec, out: Path, world: Sequence[Pose], threads: 
         for i, pose in enumerate(world, start=1):
             dst = images / f"{i:06d}.png"
             pk = _pose_key(pose)
-            src = None if any(people) else done.get(pk) or reuse.get(pk)
+            src = None if own_frames else done.get(pk) or reuse.get(pk)
             if src is not None:
                 _link_or_copy(src, dst)
                 reused += 1

@@ -31,9 +31,8 @@ OccupancyGrid::Cell OccupancyGrid::cell_of(const Eigen::Vector2d &point_m) const
           static_cast<int>(std::floor(point_m.y() / config_.resolution_m))};
 }
 
-void OccupancyGrid::update(const Cell &cell, float log_odds) {
-  float &value = log_odds_[key(cell)];
-  value = std::clamp(value + log_odds, min_, max_);
+void OccupancyGrid::update(CellState &state, float log_odds) const {
+  state.log_odds = std::clamp(state.log_odds + log_odds, min_, max_);
 }
 
 void OccupancyGrid::mark_free(const Eigen::Vector2d &from_m, const Eigen::Vector2d &to_m) {
@@ -52,8 +51,8 @@ void OccupancyGrid::mark_free(const Eigen::Vector2d &from_m, const Eigen::Vector
     delta[axis] = step[axis] != 0 ? std::abs(1.0 / direction[axis]) : std::numeric_limits<double>::infinity();
   }
   while (cell != last) {
-    const auto elevated = elevated_.find(key(cell));
-    if (elevated == elevated_.end() || !elevated->second.confirmed) update(cell, miss_);
+    CellState &state = cells_[key(cell)];
+    if (!state.above_floor) update(state, miss_);
     const int axis = next.x() < next.y() ? 0 : 1;
     if (next[axis] > 1.0) break;  // the end lies in this cell after all (rounding)
     cell[axis] += step[axis];
@@ -72,18 +71,17 @@ void OccupancyGrid::add_scan(const Eigen::Isometry2d &T_map_base, std::span<cons
     if (hit) free_m = std::min(free_m, ray.hit_m);
     if (free_m > 0.0) mark_free(origin, origin + free_m * direction);
     if (!hit) continue;
-    const Cell cell = cell_of(origin + ray.hit_m * direction);
-    if (ray.hit_elevated) {
-      const auto [elevated, first] = elevated_.try_emplace(key(cell), Elevated{origin.cast<float>()});
-      if (!first && !elevated->second.confirmed &&
-          (origin.cast<float>() - elevated->second.first_seen_from_m).norm() >= config_.elevated_baseline_m) {
-        elevated->second.confirmed = true;
-        // The floor seen under it before said nothing about it.
-        float &value = log_odds_[key(cell)];
-        value = std::max(value, 0.0f);
+    const std::uint64_t cell = key(cell_of(origin + ray.hit_m * direction));
+    CellState &state = cells_[cell];
+    if (ray.hit_elevated && !state.above_floor) {
+      const auto [first_seen, first] = first_seen_above_.try_emplace(cell, origin.cast<float>());
+      if (!first && (origin.cast<float>() - first_seen->second).norm() >= config_.elevated_baseline_m) {
+        state.above_floor = true;
+        state.log_odds = std::max(state.log_odds, 0.0f);  // the floor seen under it said nothing of it
+        first_seen_above_.erase(first_seen);
       }
     }
-    update(cell, hit_);
+    update(state, hit_);
   }
 }
 
@@ -95,7 +93,7 @@ void OccupancyGrid::seed(const GridImage &start) {
           start.cells[static_cast<std::size_t>(y) * static_cast<std::size_t>(start.width) +
                       static_cast<std::size_t>(x)];
       // Unknown cells too (at even odds): the grid keeps the extent it had.
-      log_odds_[key(low + Cell(x, y))] = cell == 100 ? max_ : (cell == 0 ? min_ : 0.0f);
+      cells_[key(low + Cell(x, y))].log_odds = cell == 100 ? max_ : (cell == 0 ? min_ : 0.0f);
     }
   }
 }
@@ -103,9 +101,9 @@ void OccupancyGrid::seed(const GridImage &start) {
 GridImage OccupancyGrid::image() const {
   GridImage image;
   image.resolution_m = config_.resolution_m;
-  if (log_odds_.empty()) return image;
+  if (cells_.empty()) return image;
   Cell low(INT_MAX, INT_MAX), high(INT_MIN, INT_MIN);
-  for (const auto &[cell_key, value] : log_odds_) {
+  for (const auto &[cell_key, state] : cells_) {
     const Cell cell(static_cast<int>(static_cast<std::int32_t>(cell_key >> 32)),
                     static_cast<int>(static_cast<std::int32_t>(cell_key & 0xffffffffu)));
     low = low.cwiseMin(cell);
@@ -116,12 +114,12 @@ GridImage OccupancyGrid::image() const {
   image.origin_m = low.cast<double>() * config_.resolution_m;
   image.cells.assign(static_cast<std::size_t>(image.width) * static_cast<std::size_t>(image.height), -1);
   const float occupied = log_odds_of(config_.occupied_threshold), free = log_odds_of(config_.free_threshold);
-  for (const auto &[cell_key, value] : log_odds_) {
+  for (const auto &[cell_key, state] : cells_) {
     const int x = static_cast<int>(static_cast<std::int32_t>(cell_key >> 32)) - low.x();
     const int y = static_cast<int>(static_cast<std::int32_t>(cell_key & 0xffffffffu)) - low.y();
     std::int8_t &cell = image.cells[static_cast<std::size_t>(y) * static_cast<std::size_t>(image.width) +
                                     static_cast<std::size_t>(x)];
-    cell = value >= occupied ? 100 : (value <= free ? 0 : -1);
+    cell = state.log_odds >= occupied ? 100 : (state.log_odds <= free ? 0 : -1);
   }
   return image;
 }

@@ -533,8 +533,12 @@ BoundaryStats FloorBoundaryFinder::find(const FloorGeometry &geometry, const cv:
         const auto stereo = triangulator.triangulate(column, edge.row_subpx, match->row_subpx);
         if (!stereo) continue;
         ++stats.elevated;
-        points.push_back(
-            {column, edge.row_subpx, match->row_subpx, stereo->range_m, stereo->height_m, false, true});
+        points.push_back({.column = column,
+                          .inner_row = edge.row_subpx,
+                          .outer_row = match->row_subpx,
+                          .range_m = stereo->range_m,
+                          .height_m = stereo->height_m,
+                          .elevated = true});
         boundary_m = static_cast<float>(stereo->range_m);
         break;
       }
@@ -608,8 +612,12 @@ BoundaryStats FloorBoundaryFinder::find(const FloorGeometry &geometry, const cv:
         const auto stereo = triangulator.triangulate(column, high.row_subpx, high_match->row_subpx);
         if (stereo && stereo->range_m < point.range_m) {
           ++stats.elevated;
-          point = {column, high.row_subpx, high_match->row_subpx, stereo->range_m, stereo->height_m, false,
-                   true};
+          point = {.column = column,
+                   .inner_row = high.row_subpx,
+                   .outer_row = high_match->row_subpx,
+                   .range_m = stereo->range_m,
+                   .height_m = stereo->height_m,
+                   .elevated = true};
         }
       }
       points.push_back(point);

@@ -80,7 +80,13 @@ class OccupancyGrid {
  private:
   using Cell = Eigen::Vector2i;
   [[nodiscard]] Cell cell_of(const Eigen::Vector2d &point_m) const;
-  void update(const Cell &cell, float log_odds);
+  /// A cell's log-odds, and whether something above the floor was seen there from two
+  /// viewpoints elevated_baseline_m apart (then floor seen under it no longer counts).
+  struct CellState {
+    float log_odds = 0.0f;
+    bool above_floor = false;
+  };
+  void update(CellState &state, float log_odds) const;
   /// Cells from `from_m` towards `to_m`, each once, excluding the cell of `to_m`.
   void mark_free(const Eigen::Vector2d &from_m, const Eigen::Vector2d &to_m);
 
@@ -88,14 +94,9 @@ class OccupancyGrid {
 
   GridConfig config_;
   float hit_ = 0.0f, miss_ = 0.0f, min_ = 0.0f, max_ = 0.0f;
-  std::unordered_map<std::uint64_t, float> log_odds_;
-  /// Cells where something above the floor was seen: from where first, and whether a second
-  /// viewpoint elevated_baseline_m away confirmed it.
-  struct Elevated {
-    Eigen::Vector2f first_seen_from_m;
-    bool confirmed = false;
-  };
-  std::unordered_map<std::uint64_t, Elevated> elevated_;
+  std::unordered_map<std::uint64_t, CellState> cells_;
+  /// Cells where something above the floor was seen from one viewpoint so far: from where.
+  std::unordered_map<std::uint64_t, Eigen::Vector2f> first_seen_above_;
 };
 
 }  // namespace omnislam::grid
