@@ -18,8 +18,8 @@ from . import odometry as odo
 from . import pov
 from .geometry import Pose, compose, inverse, relative_to_first, write_tum, read_tum
 from .rooms import building_floor, l_room, sim_room
-from .rooms_real import (building_real, checker_room, l_room_real, office_real, polished_building, polished_room,
-                         sim_room_real)
+from .rooms_real import (building_real, checker_room, home_room, l_room_real, office_real, polished_building,
+                         polished_room, sim_room_real)
 from .scene import Room, frame_scene, person_pov
 
 TRAJECTORIES_CSV = Path(__file__).resolve().parent / "data" / "trajectories.csv"
@@ -98,6 +98,14 @@ def _rectangle_loop(corners: Sequence[tuple[float, float]], steps: Sequence[int]
         (x0, y0), (x1, y1) = corners[i], corners[(i + 1) % len(corners)]
         pts += [(round(x0 + (x1 - x0) * k / n, 6), round(y0 + (y1 - y0) * k / n, 6)) for k in range(n)]
     return pts + [corners[0]]
+
+
+def home_loop() -> list[Pose]:
+    """One lap around the living room's low table (rooms_real.home_room), counter-clockwise,
+    facing the direction of travel: 50 steps of 0.25-0.26 m (12.6 m), over the extension lead
+    where it crosses the path."""
+    corners = [(1.2, 1.1), (5.2, 1.1), (5.2, 3.4), (1.2, 3.4)]
+    return facing_travel(_rectangle_loop(corners, [16, 9, 16, 9]))
 
 
 def office_loop() -> list[Pose]:
@@ -185,6 +193,9 @@ HELD_OUT: dict[str, DatasetSpec] = {
     "polished-building": DatasetSpec("polished-building", polished_building, building_loop, False,
                                      "held out: building-2laps on polished vinyl mirroring its corridors",
                                      grey=True),
+    "home": DatasetSpec("home", home_room, home_loop, False,
+                        "held out: living room, white walls on pale oak, chairs, a floor lamp, cables on the floor, "
+                        "camera 1.05 m", camera_height_m=1.05, grey=True),
     "polished-room": DatasetSpec("polished-room", polished_room, lambda: facing_travel(table_points("3.2")), False,
                                  "held out: sim-room path facing travel, polished vinyl mirroring the walls",
                                  grey=True),

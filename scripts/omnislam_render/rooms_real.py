@@ -11,7 +11,7 @@ from __future__ import annotations
 
 from .rooms import (BOXES, CABINET, CEILING, DOOR, TABLE_FOOT, TABLE_TOP, WALLS, WINDOW, building_floor, l_room,
                     sim_room)
-from .scene import AreaLamp, Box, Cylinder, Patch, Room, Rug, Skirting, Sun
+from .scene import AreaLamp, Box, Cable, Cylinder, Patch, Room, Rug, Skirting, Sphere, Sun
 
 # Indirect light is approximated by a low ambient term; the lamps do the rest.
 FINISH = "finish { ambient 0.12 diffuse 0.8 }"
@@ -41,6 +41,16 @@ def wood_planks(length_mm: float = 1200.0, width_mm: float = 150.0) -> str:
              "[0.5 rgb <0.52, 0.35, 0.19>] [1 rgb <0.40, 0.26, 0.14>] } scale 9 rotate y*90 }")
     return (f"texture {{ brick texture {{ pigment {{ rgb <0.12, 0.08, 0.05> }} {FINISH} }} "
             f"texture {{ {grain} {GLOSSY} }} brick_size <{length_mm}, {width_mm}, 1000> mortar 3 "
+            f"translate <0, 0, 500> }}")
+
+
+def pale_oak(length_mm: float = 1400.0, width_mm: float = 180.0) -> str:
+    """Pale oak laminate with light joints: a floor nearly as light as white walls and skirting,
+    so a wall's base is a faint line."""
+    grain = ("pigment { wood turbulence 0.06 color_map { [0 rgb <0.66, 0.57, 0.44>] "
+             "[0.5 rgb <0.75, 0.66, 0.52>] [1 rgb <0.66, 0.57, 0.44>] } scale 11 rotate y*90 }")
+    return (f"texture {{ brick texture {{ pigment {{ rgb <0.55, 0.47, 0.36> }} {FINISH} }} "
+            f"texture {{ {grain} {FINISH} }} brick_size <{length_mm}, {width_mm}, 1000> mortar 2 "
             f"translate <0, 0, 500> }}")
 
 
@@ -159,6 +169,63 @@ def building_real() -> Room:
     lamps = [AreaLamp((x, y, 2.9), (1.2, 0.3), 0.30) for (x, y, _), _ in floor.lights]  # where its lights are
     room = _realistic(floor, wood_planks(900.0, 120.0), lamps, None, (0.85, 0.85, 0.82))
     room.name = "building-real"
+    return room
+
+
+def _chair(name: str, x: float, y: float, back_towards_y: float) -> list:
+    """A dining chair centred at (x, y): a 0.42 m seat 0.45 m up on four legs 25 mm square, and
+    a backrest on the side whose y sign is `back_towards_y`."""
+    h, leg, seat_h = 0.21, 0.025, 0.45
+    x0, y0, x1, y1 = x - h, y - h, x + h, y + h
+    legs = [Box(f"{name} leg {k + 1}", (lx, ly, 0.0), (lx + leg, ly + leg, seat_h - 0.03), TABLE_FOOT)
+            for k, (lx, ly) in enumerate(((x0, y0), (x1 - leg, y0), (x1 - leg, y1 - leg), (x0, y1 - leg)))]
+    by0 = y1 - 0.03 if back_towards_y > 0 else y0
+    back = Box(f"{name} back", (x0, by0, seat_h), (x1, by0 + 0.03, 0.90), (0.30, 0.22, 0.16))
+    return [Box(f"{name} seat", (x0, y0, seat_h - 0.03), (x1, y1, seat_h), (0.30, 0.22, 0.16)), *legs, back]
+
+
+def home_room() -> Room:
+    """A held-out scene (not bundled): a living room 6.4 x 4.6 m, 2.6 m high, with white walls
+    and white skirting on a pale oak floor (a wall's base a faint line), two chairs on thin legs
+    at a desk, a floor lamp on a thin pole, a sofa, a low table on a rug, a TV on a stand, a
+    plant, and cables lying loose on the floor: an extension lead from the right wall across
+    the robot's path to the low table (black), a white charger cable by the desk, the lamp's
+    cable to the bottom wall (black)."""
+    outline = [(0.0, 0.0), (6.4, 0.0), (6.4, 4.6), (0.0, 4.6)]  # walls: 0 bottom, 1 right, 2 top, 3 left
+    white = (0.86, 0.85, 0.82)
+    objects = [
+        Box("sofa", (2.0, 0.0, 0.0), (4.2, 0.6, 0.8), (0.45, 0.47, 0.52)),
+        *_legged_table("low table", 2.4, 1.9, 3.8, 2.6, 0.42),
+        *_legged_table("desk", 2.0, 4.0, 3.8, 4.6, 0.74),
+        *_chair("chair 1", 2.5, 3.85 + 0.2, -1.0),
+        *_chair("chair 2", 3.3, 3.85 + 0.2, -1.0),
+        Cylinder("lamp base", (0.45, 0.45), 0.14, 0.0, 0.025, (0.15, 0.15, 0.15)),
+        Cylinder("lamp pole", (0.45, 0.45), 0.012, 0.025, 1.45, (0.15, 0.15, 0.15)),
+        Cylinder("lamp shade", (0.45, 0.45), 0.2, 1.45, 1.7, (0.92, 0.88, 0.78)),
+        Box("bookshelf", (0.0, 2.0, 0.0), (0.35, 3.2, 1.9), CABINET),
+        Box("tv stand", (6.0, 1.6, 0.0), (6.4, 2.9, 0.5), (0.20, 0.20, 0.22)),
+        Box("tv", (6.3, 1.7, 0.55), (6.35, 2.8, 1.2), (0.05, 0.05, 0.06)),
+        Cylinder("plant pot", (5.9, 0.45), 0.18, 0.0, 0.4, (0.70, 0.40, 0.25)),
+        Sphere("plant", (5.9, 0.45, 0.72), 0.3, (0.20, 0.40, 0.18)),
+    ]
+    patches = [
+        Patch("window", 1, 0.3, 1.4, 0.9, 2.2, WINDOW),       # wall 1: (6.4, 0) -> (6.4, 4.6)
+        Patch("door", 3, 0.2, 1.1, 0.0, 2.0, DOOR),           # wall 3: (0, 4.6) -> (0, 0)
+    ]
+    lamps = [AreaLamp((x, 2.3, 2.55), (0.6, 0.6), 0.45) for x in (1.8, 4.6)]
+    sun = Sun("window", azimuth_deg=20.0, elevation_deg=30.0, power=1.3)
+    room = Room("home", outline, [white] * 4, (0.7, 0.6, 0.5), CEILING, 2.6, objects, patches)
+    rug = Rug("rug", (2.1, 1.6), (4.1, 2.9), 0.008, rug_texture(2.1, 1.6, 4.1, 2.9))
+    room = _realistic(room, pale_oak(), lamps, sun, (0.90, 0.90, 0.88), [rug])
+    room.name = "home"
+    room.cables = [
+        Cable("extension lead", [(6.38, 3.8), (6.0, 3.75), (5.6, 3.62), (5.1, 3.35), (4.6, 3.0), (4.1, 2.75),
+                                 (3.8, 2.62)], 0.004, (0.05, 0.05, 0.05)),
+        Cable("charger cable", [(1.85, 4.55), (1.7, 4.2), (1.75, 3.9), (2.05, 3.75), (2.3, 3.78)], 0.0025,
+              (0.88, 0.88, 0.86)),
+        Cable("lamp cable", [(0.55, 0.5), (0.95, 0.62), (1.35, 0.58), (1.7, 0.35), (1.8, 0.02)], 0.003,
+              (0.05, 0.05, 0.05)),
+    ]
     return room
 
 

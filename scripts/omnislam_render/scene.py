@@ -169,6 +169,23 @@ class Rug:
 
 
 @dataclass
+class Cable:
+    """A cable lying loose on the floor along a polyline (x, y in m): a dark or light line
+    a few millimetres high that a robot drives over; floor texture, not an obstacle (not in
+    the floor plan)."""
+    name: str
+    points: list[tuple[float, float]]
+    radius: float
+    colour: Colour
+
+    def pov(self, finish: str = MATT) -> str:
+        r = num(self.radius * 1000)
+        knots = ", ".join(f"{vec(*_mm(x, y, self.radius))}, {r}" for x, y in self.points)
+        return (f"sphere_sweep {{ linear_spline {len(self.points)}, {knots} "
+                f"pigment {{ {_rgb(self.colour)} }} {finish} }}  // {self.name}")
+
+
+@dataclass
 class Skirting:
     """Skirting boards along every wall: the floor contact moves to their face, which the
     floor plan follows."""
@@ -195,6 +212,7 @@ class Room:
     sun: Sun | None = None
     rugs: list[Rug] = field(default_factory=list)
     skirting: Skirting | None = None
+    cables: list[Cable] = field(default_factory=list)
 
     # ---------------------------------------------------------------- geometry
     def walls(self) -> list[Segment]:
@@ -302,6 +320,7 @@ class Room:
             parts += self._skirting_pov()
         parts += [f"box {{ {vec(*_mm(*rug.lo, 0.0))}, {vec(*_mm(*rug.hi, rug.thickness))} {rug.texture} }}"
                   f"  // {rug.name}" for rug in self.rugs]
+        parts += [cable.pov(self.finish) for cable in self.cables]
         parts += [obj.pov(self.finish) for obj in self.objects]
         parts += [f"light_source {{ {vec(*_mm(*pos))} color rgb {num(power)} shadowless }}"
                   for pos, power in self.lights]

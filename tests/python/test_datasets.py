@@ -5,6 +5,7 @@ Run from the repository root:  python3 -m pytest tests/python -q
 from __future__ import annotations
 
 import math
+import re
 import subprocess
 import sys
 
@@ -421,6 +422,39 @@ def test_building_floor_skirting_lines_every_side_of_the_free_floor():
         lengths.append(size[1])
     assert sorted(lengths) == pytest.approx(
         sorted(1000.0 * math.hypot(x2 - x1, y2 - y1) for x1, y1, x2, y2 in bare.walls()))
+
+
+def test_home_cables_lie_on_the_floor_outside_the_plan_and_cross_the_path():
+    # The held-out living room: its cables are floor texture a few millimetres high (not in the
+    # floor plan, which draws what a robot cannot drive over), one of them crosses the path,
+    # and the path clears every object in the plan.
+    spec = datasets.HELD_OUT["home"]
+    room, world = spec.room(), spec.world_poses()
+    sweeps = [line for line in room.pov_body().splitlines() if line.strip().startswith("sphere_sweep")]
+    assert len(sweeps) == len(room.cables) == 3
+    for cable, line in zip(room.cables, sweeps):
+        assert line.rstrip().endswith(f"// {cable.name}")
+        knots = [[float(v) for v in knot.split(",")] for knot in re.findall(r"<([^>]*)>", line)[:len(cable.points)]]
+        assert np.allclose([k[:2] for k in knots], 1000.0 * np.array(cable.points))
+        assert all(k[2] == pytest.approx(1000.0 * cable.radius) for k in knots)  # lying on the floor
+    plan = {tuple(round(v, 6) for v in seg) for seg in room.floorplan()}
+    for cable in room.cables:
+        for (x1, y1), (x2, y2) in zip(cable.points, cable.points[1:]):
+            assert (x1, y1, x2, y2) not in plan
+
+    def crosses(p, q, a, b):
+        def side(u, v, w):
+            return (v[0] - u[0]) * (w[1] - u[1]) - (v[1] - u[1]) * (w[0] - u[0])
+        return side(p, q, a) * side(p, q, b) < 0 and side(a, b, p) * side(a, b, q) < 0
+
+    path = [(x, y) for x, y, _ in world]
+    lead = room.cables[0].points
+    assert any(crosses(p, q, a, b) for p, q in zip(path, path[1:]) for a, b in zip(lead, lead[1:]))
+    for a, b in zip(world[:-1], world[1:]):
+        for t in np.linspace(0.0, 1.0, 21):
+            dist, what = room.clearance(a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1]))
+            assert dist >= 0.4, what
+    assert spec.camera_height_m == 1.05 and spec.grey
 
 
 def test_frames_option_limits_metadata(tmp_path):
