@@ -71,10 +71,13 @@ TEST_CASE("sim-room-37: local scans against the floor plan", "[stereo][accuracy]
   CHECK(accuracy.median_relative_error() <= 0.02);
   CHECK(accuracy.near_segment_share() >= 0.90);
   CHECK(accuracy.coverage() >= 0.80);
-  // Free floor is known almost everywhere; where it reaches past the plan, it is mostly the
+  // Free floor is known in most columns; where it reaches past the plan, it is mostly the
   // floor seen under an overhang (the table top, the sphere), which the plan draws as solid.
-  CHECK(accuracy.free_known_share() >= 0.90);
-  CHECK(accuracy.free_overclaim_share() <= 0.15);
+  // A column whose boundary is an edge above the floor with no floor contact says nothing of
+  // the floor in front of it on this plain floor (87.7%, 5.0% past the plan; 96.1% and 8.5%
+  // when such a column claimed the floor free up to the edge, across the platform's top).
+  CHECK(accuracy.free_known_share() >= 0.85);
+  CHECK(accuracy.free_overclaim_share() <= 0.08);
 }
 
 // Tiled floor, soft shadows, sunlight; then every sensor factor on top. Measured: noise-free
@@ -118,13 +121,14 @@ TEST_CASE("office-real: local scans against the floor plan", "[stereo][accuracy]
 
 // The L-room with oak planks, a rug, pendant lamps over the tables and sunlight. Measured:
 // degraded 0.64% / 94.1% within 0.1 m / coverage 81.1% (93.3% / 81.6% before the changes
-// noted at the office).
+// noted at the office); free range known in 86.3% of columns (94.3% when an edge above the
+// floor with no floor contact claimed the floor free up to it).
 TEST_CASE("l-room-1lap-real: local scans against the floor plan", "[stereo][accuracy][dataset]") {
   const omnislam::test::ScanAccuracy degraded = scan_accuracy("l-room-1lap-real", 60, true);
   CHECK(degraded.median_relative_error() <= 0.02);
   CHECK(degraded.near_segment_share() >= 0.90);
   CHECK(degraded.coverage() >= 0.80);
-  CHECK(degraded.free_known_share() >= 0.90);
+  CHECK(degraded.free_known_share() >= 0.82);
   CHECK(degraded.free_overclaim_share() <= 0.17);
 }
 

@@ -489,6 +489,7 @@ BoundaryStats FloorBoundaryFinder::find(const FloorGeometry &geometry, const cv:
     float free_end_m = kNaN;          // an edge off the floor that nothing explains
     float farthest_floor_row = kNaN;  // the farthest edge found to be floor texture
     float boundary_m = kNaN;
+    bool floor_reaches_boundary = false;  // a floor contact: the floor was seen up to it
     const auto inner_edges_here = inner_candidates.column(column);
     // 1. Is there an outer edge of the same polarity where the floor puts each edge? (Asked
     //    once per edge: steps 4 and 5 ask it again of the edges above.)
@@ -622,16 +623,24 @@ BoundaryStats FloorBoundaryFinder::find(const FloorGeometry &geometry, const cv:
       }
       points.push_back(point);
       boundary_m = static_cast<float>(point.range_m);
+      floor_reaches_boundary = true;
       break;
     }
+    // Free floor as far as it was seen: up to a floor contact (the floor reaches it), else up
+    // to the first edge nothing explains or the farthest floor texture. An edge matched above
+    // the floor before any contact (step 2) says nothing of the floor in front of it: under a
+    // table the floor's texture shows it, but the face of a box, a sofa or a low platform
+    // hides it (with its base in the blind zone or its front edge without contrast, the edge
+    // matched is its back edge), so the floor is free only as far as it was seen, short of it.
     float &free_m = free_range_m[static_cast<std::size_t>(column)];
-    if (std::isfinite(boundary_m)) {
+    if (floor_reaches_boundary) {
       free_m = std::isfinite(free_end_m) ? std::min(free_end_m, boundary_m) : boundary_m;
     } else {
       free_m = std::isfinite(free_end_m) ? free_end_m
                : std::isfinite(farthest_floor_row)
                    ? static_cast<float>(geometry_->floor_range_at(farthest_floor_row))
                    : kNaN;
+      if (std::isfinite(boundary_m) && std::isfinite(free_m)) free_m = std::min(free_m, boundary_m);
     }
   }
   return stats;
