@@ -89,3 +89,31 @@ TEST_CASE("floor boundary on the convention image: one point per column at most,
   CHECK(nearest_scan.free_range_m.empty());
   CHECK(nearest_scan.points.size() > 100u);
 }
+
+TEST_CASE("a frame of pure sensor noise gives no scan, and the convention image keeps its walls under noise",
+          "[stereo][floor][noise]") {
+  cv::Mat normal(1024, 1024, CV_32FC1), noise;
+  cv::RNG rng(29);
+  rng.fill(normal, cv::RNG::NORMAL, 128.0, 10.0);
+  normal.convertTo(noise, CV_8UC1);
+  omnislam::stereo::ScanReconstructor reconstructor;
+  const omnislam::stereo::LocalScan nothing = reconstructor.reconstruct(noise);
+  CHECK(nothing.stats.image_noise_dn == Approx(10.0).epsilon(0.1));
+  // 263 floor contacts when Canny's thresholds ignored the noise.
+  CHECK(nothing.points.empty());
+  CHECK(nothing.stats.inner.noise_high_threshold > nothing.stats.inner.high_threshold);
+
+  const cv::Mat image = cv::imread(OMNISLAM_CONVENTION_IMAGE, cv::IMREAD_GRAYSCALE);
+  REQUIRE_FALSE(image.empty());
+  const omnislam::stereo::LocalScan clean = reconstructor.reconstruct(image);
+  CHECK(clean.stats.image_noise_dn < 1.0f);
+  CHECK(clean.stats.inner.noise_high_threshold == 0.0);  // the image's own thresholds stand
+  cv::Mat noisy_float, noisy;
+  image.convertTo(noisy_float, CV_32FC1);
+  rng.fill(normal, cv::RNG::NORMAL, 0.0, 10.0);
+  noisy_float += normal;
+  noisy_float.convertTo(noisy, CV_8UC1);
+  const omnislam::stereo::LocalScan walls = reconstructor.reconstruct(noisy);
+  INFO("points: clean " << clean.points.size() << ", noisy " << walls.points.size());
+  CHECK(walls.points.size() > clean.points.size() / 2);
+}

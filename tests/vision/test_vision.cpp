@@ -5,11 +5,13 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <string>
+#include <vector>
 
 #include "omnislam/mirror/mirror_model.hpp"
 #include "omnislam/mirror/panorama_maps.hpp"
 #include "omnislam/vision/edge_detector.hpp"
 #include "omnislam/vision/edge_selection.hpp"
+#include "omnislam/vision/image_noise.hpp"
 #include "omnislam/vision/panorama_unwarper.hpp"
 #include "omnislam/vision/ray_subpixel.hpp"
 #include "omnislam/vision/texture.hpp"
@@ -311,4 +313,118 @@ TEST_CASE(
   // Canny's gradient mixes the neighbouring columns' rows, weighted by their contrast.
   CHECK(canny_error / found > 0.15);
   CHECK(ray_error / found < 0.05);
+}
+
+namespace {
+
+// A frame-sized scene with plenty of structure: tiles of random grey with sharp edges, a
+// shading ramp across the frame and a few bright lines, inside the mirror's annulus.
+cv::Mat structured_frame() {
+  cv::Mat frame(1024, 1024, CV_8UC1);
+  cv::RNG rng(7);
+  for (int y = 0; y < frame.rows; y += 48)
+    for (int x = 0; x < frame.cols; x += 64)
+      frame(cv::Rect(x, y, std::min(64, frame.cols - x), std::min(48, frame.rows - y)))
+          .setTo(rng.uniform(40, 200));
+  cv::Mat ramp(frame.size(), CV_8UC1);
+  for (int y = 0; y < frame.rows; ++y) ramp.row(y).setTo(y / 32);
+  frame += ramp;
+  for (int k = 0; k < 20; ++k)
+    cv::line(frame, {rng.uniform(0, 1024), rng.uniform(0, 1024)},
+             {rng.uniform(0, 1024), rng.uniform(0, 1024)}, cv::Scalar(230), 2, cv::LINE_AA);
+  return frame;
+}
+
+cv::Mat with_noise(const cv::Mat &frame, double deviation, std::uint64_t seed) {
+  cv::Mat noise(frame.size(), CV_32FC1), noisy;
+  cv::RNG rng(seed);
+  rng.fill(noise, cv::RNG::NORMAL, 0.0, deviation);
+  frame.convertTo(noisy, CV_32FC1);
+  noisy += noise;
+  noisy.convertTo(noisy, CV_8UC1);
+  return noisy;
+}
+
+}  // namespace
+
+TEST_CASE("image noise: a frame's noise deviation, whatever its edges, texture and shading",
+          "[vision][noise]") {
+  const cv::Mat scene = structured_frame();
+  const ImageAnnulus annulus;
+  // Noise-free: the edges, tiles and ramp alone read as (almost) no noise.
+  CHECK(image_noise_dn(scene, annulus) < 0.6);
+  for (const double deviation : {2.0, 5.0, 10.0, 20.0}) {
+    INFO("noise deviation " << deviation);
+    const double estimate = image_noise_dn(with_noise(scene, deviation, 11), annulus);
+    CHECK(estimate == Approx(deviation).epsilon(0.1).margin(0.3));  // 8-bit rounding adds 0.29
+  }
+  // Only the annulus counts: noise outside it does not, inside it does.
+  cv::Mat outside = scene.clone();
+  cv::Mat noisy = with_noise(scene, 20.0, 3);
+  cv::Mat ring_mask(scene.size(), CV_8UC1, cv::Scalar(255));
+  cv::circle(ring_mask, {512, 512}, 500, cv::Scalar(0), cv::FILLED);
+  noisy.copyTo(outside, ring_mask);
+  CHECK(image_noise_dn(outside, annulus) < 0.6);
+  CHECK(image_noise_dn(cv::Mat::zeros(1024, 1024, CV_8UC1), annulus) == 0.0);
+  CHECK(image_noise_dn(noisy, {{511.5, 511.5}, 0.0, 0.0}) == 0.0);  // an empty annulus
+}
+
+TEST_CASE("Canny's noise floor: a row's high threshold rises to what the noise reaches there",
+          "[vision][canny][noise]") {
+  // A panorama of pure noise (deviation 10) over a step of 60 grey levels at row 150.
+  cv::Mat pano = step_panorama(150.0);
+  cv::Mat noise(pano.size(), CV_32FC1), noisy;
+  cv::RNG rng(5);
+  rng.fill(noise, cv::RNG::NORMAL, 0.0, 10.0);
+  pano.convertTo(noisy, CV_32FC1);
+  noisy += noise;
+  noisy.convertTo(noisy, CV_8UC1);
+
+  EdgeDetector detector;
+  // The gain per grey level of noise, from a panorama of pure noise of deviation 20.
+  cv::Mat unit(pano.size(), CV_32FC1), unit8;
+  rng.fill(unit, cv::RNG::NORMAL, 128.0, 20.0);
+  unit.convertTo(unit8, CV_8UC1);
+  const std::vector<float> scale = detector.gradient_noise_per_row(unit8);
+  REQUIRE(scale.size() == static_cast<std::size_t>(pano.rows));
+  // A Rayleigh scale per row, the same in every row of a panorama of white noise, and in
+  // proportion to the noise's deviation.
+  std::vector<float> sorted = scale;
+  std::sort(sorted.begin(), sorted.end());
+  const float median = sorted[sorted.size() / 2];
+  for (std::size_t row = 5; row + 5 < scale.size(); ++row)  // the smoothing replicates the border rows
+    CHECK(scale[row] == Approx(median).epsilon(0.15));      // a median of 1,800 samples
+  cv::Mat half8;
+  unit8.convertTo(half8, CV_8UC1, 0.5, 64.0);  // deviation 10
+  const std::vector<float> half_scale = detector.gradient_noise_per_row(half8);
+  CHECK(half_scale[100] == Approx(scale[100] / 2.0f).epsilon(0.1));
+
+  const float tail = std::sqrt(2.0f * std::log(static_cast<float>(pano.total())));  // one pixel per panorama
+  std::vector<float> floor(scale.size());
+  for (std::size_t row = 0; row < floor.size(); ++row) floor[row] = scale[row] / 20.0f * 10.0f * tail;
+
+  EdgeImage plain, floored;
+  detector.detect(noisy, plain);
+  detector.detect(noisy, floored, floor);
+  const auto edges_off_the_step = [](const EdgeImage &edges) {
+    int count = 0;
+    for (int row = 0; row < edges.edges.rows; ++row)
+      if (std::abs(row - 150) > 3) count += cv::countNonZero(edges.edges.row(row));
+    return count;
+  };
+  INFO("noise edges without the floor " << edges_off_the_step(plain) << ", with it "
+                                        << edges_off_the_step(floored));
+  CHECK(edges_off_the_step(plain) > 500);
+  CHECK(edges_off_the_step(floored) < 100);
+  CHECK(floored.noise_high_threshold > floored.high_threshold);
+  // The step stands out of the noise: still found in nearly every column.
+  CHECK(cv::countNonZero(floored.edges.rowRange(147, 154)) > 0.95 * pano.cols);
+  // Fixed thresholds ignore the floor.
+  CannyConfig fixed;
+  fixed.auto_thresholds = false;
+  EdgeDetector fixed_detector(fixed);
+  EdgeImage as_given;
+  fixed_detector.detect(noisy, as_given, floor);
+  CHECK(as_given.high_threshold == fixed.high_threshold);
+  CHECK(as_given.noise_high_threshold == 0.0);
 }

@@ -1,4 +1,5 @@
 #include "scan_command.hpp"
+#include <algorithm>
 
 #include <cstdio>
 #include <memory>
@@ -48,6 +49,12 @@ void print_summary(const std::string &image, const stereo::LocalScan &scan) {
                "no intersection %d, outside cut-offs %d, filtered %d, points %d\n",
                image.c_str(), s.inner.candidates, s.outer.candidates, s.admissible_pairs, s.matched,
                s.no_intersection, s.outside_cutoffs, s.filtered_out, s.points);
+  std::fprintf(stderr,
+               "%s: noise %.2f grey levels; Canny high threshold inner %.1f / outer %.1f, raised by the "
+               "noise to at most %.1f / %.1f\n",
+               image.c_str(), static_cast<double>(s.image_noise_dn), s.inner.high_threshold,
+               s.outer.high_threshold, std::max(s.inner.high_threshold, s.inner.noise_high_threshold),
+               std::max(s.outer.high_threshold, s.outer.noise_high_threshold));
   if (!scan.free_range_m.empty()) {
     std::fprintf(stderr,
                  "%s: floor boundary: floor texture %d, floor contacts %d (undecided %d), elevated %d, "

@@ -109,6 +109,7 @@ void read_vision(YamlSection &section, vision::VisionConfig &vision) {
   section.read("auto_not_edge_fraction", canny.auto_not_edge_fraction);
   section.read("auto_low_ratio", canny.auto_low_ratio);
   section.read("auto_min_high_threshold", canny.auto_min_high_threshold);
+  section.read("noise_edges_per_panorama", canny.noise_edges_per_panorama);
   section.read("min_fragment_px", canny.min_fragment_px);
   vision::EdgeSelectionConfig &selection = vision.selection;
   section.read("horizontal_ratio", selection.horizontal_ratio);

@@ -6,6 +6,7 @@
 #include <limits>
 #include <numbers>
 #include <optional>
+#include <tuple>
 #include <utility>
 
 #include "omnislam/mirror/panorama_maps.hpp"
@@ -29,6 +30,7 @@ LobeStats lobe_stats(const LobeWork &work) {
   stats.fragment_px_removed = work.edges.fragment_px_removed;
   stats.low_threshold = work.edges.low_threshold;
   stats.high_threshold = work.edges.high_threshold;
+  stats.noise_high_threshold = work.edges.noise_high_threshold;
   stats.horizontal_px = work.selection.horizontal_px;
   stats.runs = work.selection.runs;
   stats.not_local_max = work.selection.not_local_max;
@@ -81,6 +83,31 @@ ScanReconstructor::ScanReconstructor(const ScanConfig &config)
     column_sin_.push_back(std::sin(azimuth));
   }
   matches_.reserve(static_cast<std::size_t>(config.camera.columns) * 4);
+  annulus_ = {{config.camera.center_u_px, config.camera.center_v_px},
+              static_cast<double>(config.camera.discard_px),
+              static_cast<double>(config.camera.discard_px + 2 * config.camera.rows_per_lobe)};
+  if (config.vision.canny.auto_thresholds && config.vision.canny.noise_edges_per_panorama > 0.0)
+    measure_noise_gain();
+}
+
+void ScanReconstructor::measure_noise_gain() {
+  constexpr double kDeviation = 20.0;  // grey levels: far above 8-bit rounding, clipped at 6.4 sigma
+  cv::Mat normal(config_.camera.image_height_px, config_.camera.image_width_px, CV_32FC1);
+  cv::RNG rng(20261207);
+  rng.fill(normal, cv::RNG::NORMAL, 128.0, kDeviation);
+  cv::Mat noise, panorama;
+  normal.convertTo(noise, CV_8UC1);
+  for (const auto lobe : {mirror::Lobe::kInner, mirror::Lobe::kOuter}) {
+    unwarper_.unwarp(noise, lobe, panorama);
+    vision::EdgeDetector &detector = lobe == mirror::Lobe::kInner ? inner_detector_ : outer_detector_;
+    std::vector<float> gain = detector.gradient_noise_per_row(panorama);
+    const double pixels = static_cast<double>(panorama.rows) * panorama.cols;
+    const auto tail = static_cast<float>(
+        std::sqrt(2.0 * std::log(std::max(1.0, pixels / config_.vision.canny.noise_edges_per_panorama))) /
+        kDeviation);
+    for (float &value : gain) value *= tail;
+    (lobe == mirror::Lobe::kInner ? inner_noise_gain_ : outer_noise_gain_) = std::move(gain);
+  }
 }
 
 LocalScan ScanReconstructor::reconstruct(const cv::Mat &image) {
@@ -114,11 +141,19 @@ void ScanReconstructor::unwarp(const cv::Mat &image) {
   unwarper_.unwarp(image, mirror::Lobe::kInner, inner_.panorama);
   unwarper_.prefetch(image, mirror::Lobe::kOuter);
   unwarper_.unwarp(image, mirror::Lobe::kOuter, outer_.panorama);
+  const double noise_dn = inner_noise_gain_.empty() ? 0.0 : vision::image_noise_dn(image, annulus_);
+  inner_.image_noise_dn = noise_dn;
+  outer_.image_noise_dn = noise_dn;
 }
 
 void ScanReconstructor::detect_edges() {
-  inner_detector_.detect(inner_.panorama, inner_.edges);
-  outer_detector_.detect(outer_.panorama, outer_.edges);
+  for (auto [work, detector, gain] : {std::tuple{&inner_, &inner_detector_, &inner_noise_gain_},
+                                      std::tuple{&outer_, &outer_detector_, &outer_noise_gain_}}) {
+    noise_floor_.resize(gain->size());
+    for (std::size_t row = 0; row < gain->size(); ++row)
+      noise_floor_[row] = (*gain)[row] * static_cast<float>(work->image_noise_dn);
+    detector->detect(work->panorama, work->edges, noise_floor_);
+  }
 }
 
 void ScanReconstructor::select_edges() {
@@ -151,6 +186,7 @@ void ScanReconstructor::swap_lobes(LobeWork &inner, LobeWork &outer) noexcept {
 
 void ScanReconstructor::triangulate(LocalScan &scan) {
   scan.stats.inner = lobe_stats(inner_);
+  scan.stats.image_noise_dn = static_cast<float>(inner_.image_noise_dn);
   scan.stats.outer = lobe_stats(outer_);
   scan.stats.admissible_pairs = match_stats_.admissible_pairs;
   scan.stats.matched = match_stats_.matched;

@@ -39,7 +39,7 @@ EdgeDetector::EdgeDetector(const CannyConfig &config) : config_(config) {
   kernel_size_ = cv::Size(2 * half + 1, 2 * half + 1);
 }
 
-void EdgeDetector::detect(const cv::Mat &panorama, EdgeImage &out) {
+void EdgeDetector::smooth_and_differentiate(const cv::Mat &panorama, EdgeImage &out) {
   if (config_.sigma_px > 0.0) {
     cv::GaussianBlur(panorama, smoothed_, kernel_size_, config_.sigma_px, config_.sigma_px,
                      cv::BORDER_REPLICATE);
@@ -47,9 +47,36 @@ void EdgeDetector::detect(const cv::Mat &panorama, EdgeImage &out) {
     panorama.copyTo(smoothed_);
   }
   cv::spatialGradient(smoothed_, out.grad_col, out.grad_row, 3, cv::BORDER_REPLICATE);  // Sobel 3x3
-  choose_thresholds(out);
+}
+
+void EdgeDetector::detect(const cv::Mat &panorama, EdgeImage &out, std::span<const float> noise_floor) {
+  smooth_and_differentiate(panorama, out);
+  choose_thresholds(out, noise_floor);
   suppress_non_maxima(out);
   trace_edges(out);
+}
+
+std::vector<float> EdgeDetector::gradient_noise_per_row(const cv::Mat &panorama) {
+  EdgeImage gradient;
+  smooth_and_differentiate(panorama, gradient);
+  const int rows = gradient.grad_row.rows, columns = gradient.grad_row.cols;
+  constexpr int kHalfRows = 2;
+  const float rayleigh_median = std::sqrt(2.0f * std::log(2.0f));
+  std::vector<float> magnitudes;
+  std::vector<float> scale(static_cast<std::size_t>(rows), 0.0f);
+  for (int row = 0; row < rows; ++row) {
+    magnitudes.clear();
+    for (int r = std::max(0, row - kHalfRows); r <= std::min(rows - 1, row + kHalfRows); ++r) {
+      const auto *gr = gradient.grad_row.ptr<std::int16_t>(r);
+      const auto *gc = gradient.grad_col.ptr<std::int16_t>(r);
+      for (int col = 0; col < columns; ++col)
+        magnitudes.push_back(std::hypot(static_cast<float>(gr[col]), static_cast<float>(gc[col])));
+    }
+    const auto middle = magnitudes.begin() + static_cast<std::ptrdiff_t>(magnitudes.size() / 2);
+    std::nth_element(magnitudes.begin(), middle, magnitudes.end());
+    scale[static_cast<std::size_t>(row)] = *middle / rayleigh_median;
+  }
+  return scale;
 }
 
 OMNISLAM_WIDE_VECTORS void EdgeDetector::suppress_non_maxima(const EdgeImage &out) {
@@ -76,11 +103,6 @@ OMNISLAM_WIDE_VECTORS void EdgeDetector::suppress_non_maxima(const EdgeImage &ou
                            magnitude_rows_.data() + 2 * padded};
   fill(-1, ring[0]);
   fill(0, ring[1]);
-  // Thresholds beyond any magnitude are capped (as cv::Canny does) so that squares fit.
-  const double low_capped = std::min(out.low_threshold, kMaxThreshold);
-  const double high_capped = std::min(out.high_threshold, kMaxThreshold);
-  const auto low = static_cast<std::int32_t>(std::floor(low_capped * low_capped));
-  const auto high = static_cast<std::int32_t>(std::floor(high_capped * high_capped));
   state_.create(rows + 2, columns + 2, CV_8UC1);
   state_.setTo(kNotEdge);
   // Branch-free and without gathers, so that the compiler vectorises it: about half the
@@ -98,6 +120,8 @@ OMNISLAM_WIDE_VECTORS void EdgeDetector::suppress_non_maxima(const EdgeImage &ou
     const std::int32_t *m = ring[1] + 1;
     const std::int32_t *below = ring[2] + 1;
     std::uint8_t *state = state_.ptr<std::uint8_t>(row + 1) + 1;
+    const std::int32_t low = row_low_sq_[static_cast<std::size_t>(row)];
+    const std::int32_t high = row_high_sq_[static_cast<std::size_t>(row)];
     for (int col = 0; col < columns; ++col) {
       const int across = std::abs(static_cast<int>(gc[col])), along = std::abs(static_cast<int>(gr[col]));
       const int tan22 = across * kTan22Q15, scaled = along * kQ15;
@@ -184,12 +208,37 @@ void EdgeDetector::trace_edges(EdgeImage &out) {
   cv::compare(state_(interior), kVisited, out.edges, cv::CMP_EQ);
 }
 
-void EdgeDetector::choose_thresholds(EdgeImage &out) {
+void EdgeDetector::choose_thresholds(EdgeImage &out, std::span<const float> noise_floor) {
+  const int rows = out.grad_row.rows;
+  // Thresholds beyond any magnitude are capped (as cv::Canny does) so that squares fit.
+  const auto squared = [](double threshold) {
+    const double capped = std::min(threshold, kMaxThreshold);
+    return static_cast<std::int32_t>(std::floor(capped * capped));
+  };
+  out.noise_high_threshold = 0.0;
   if (!config_.auto_thresholds) {
     out.high_threshold = config_.high_threshold;
     out.low_threshold = config_.low_threshold;
+    row_low_sq_.assign(static_cast<std::size_t>(rows), squared(out.low_threshold));
+    row_high_sq_.assign(static_cast<std::size_t>(rows), squared(out.high_threshold));
     return;
   }
+  choose_auto_thresholds(out);
+  // Each row's high threshold is at least what the frame's noise reaches there.
+  row_low_sq_.resize(static_cast<std::size_t>(rows));
+  row_high_sq_.resize(static_cast<std::size_t>(rows));
+  const bool floored = static_cast<int>(noise_floor.size()) == rows;
+  for (int row = 0; row < rows; ++row) {
+    const double floor = floored ? static_cast<double>(noise_floor[static_cast<std::size_t>(row)]) : 0.0;
+    const double high = std::max(out.high_threshold, floor);
+    if (floor > out.high_threshold) out.noise_high_threshold = std::max(out.noise_high_threshold, floor);
+    row_high_sq_[static_cast<std::size_t>(row)] = squared(high);
+    row_low_sq_[static_cast<std::size_t>(row)] =
+        squared(high == out.high_threshold ? out.low_threshold : config_.auto_low_ratio * high);
+  }
+}
+
+void EdgeDetector::choose_auto_thresholds(EdgeImage &out) {
   // Quantile of the L2 gradient magnitude via an integer histogram of every other pixel
   // of every other row (a quarter of the pixels estimates a quantile to well under 1%).
   std::array<int, kMagnitudeBins> histogram{};

@@ -42,6 +42,7 @@ struct LobeStats {
   int candidates = 0;  ///< edge points handed to the matcher
   double low_threshold = 0.0;
   double high_threshold = 0.0;
+  double noise_high_threshold = 0.0;  ///< the largest row threshold the frame's noise raised (0: none)
 };
 
 struct ScanStats {
@@ -65,6 +66,8 @@ struct ScanStats {
   /// edges' outer twins about where the floor puts them.
   float twin_spread_px = 0.0f;
   int points = 0;  ///< points in the scan
+  /// The frame's sensor noise, grey levels (vision/image_noise.hpp; 0 when not measured).
+  float image_noise_dn = 0.0f;
 };
 
 enum class ScanStatus {

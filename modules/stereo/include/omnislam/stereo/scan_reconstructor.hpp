@@ -14,6 +14,7 @@
 #include "omnislam/stereo/stereo_config.hpp"
 #include "omnislam/vision/edge_detector.hpp"
 #include "omnislam/vision/edge_selection.hpp"
+#include "omnislam/vision/image_noise.hpp"
 #include "omnislam/vision/panorama_unwarper.hpp"
 
 /// @file
@@ -28,6 +29,7 @@ struct LobeWork {
   vision::EdgeImage edges;
   vision::ColumnEdges candidates;
   vision::SelectionStats selection;
+  double image_noise_dn = 0.0;  ///< the frame's sensor noise (vision/image_noise.hpp)
 };
 
 /// Holds everything computed once per camera (remap tables, disparity bands, row
@@ -46,7 +48,7 @@ class ScanReconstructor {
 
   /// Stages, in order. Each reads what the previous one left in the working state.
   [[nodiscard]] bool accepts(const cv::Mat &image) const;
-  void unwarp(const cv::Mat &image);  ///< step 1, both lobes
+  void unwarp(const cv::Mat &image);  ///< step 1, both lobes, and the frame's noise
   void detect_edges();                ///< step 2, both lobes
   void select_edges();                ///< steps 3-4, both lobes
   void match();                       ///< step 5, every column pair (or the floor-boundary search)
@@ -75,6 +77,11 @@ class ScanReconstructor {
     return config_.stereo.boundary == BoundaryMethod::kFloorBoundary;
   }
   void build_boundary_scan(LocalScan &scan);
+  /// The noise floor's gain: a frame of pure noise through each lobe's panorama maps and its
+  /// detector's smoothing and gradient gives, row by row, the Rayleigh scale of the gradient
+  /// per grey level of pixel noise; times sqrt(2 ln(N / n)), the magnitude that noise exceeds
+  /// at n (noise_edges_per_panorama) of the panorama's N pixels.
+  void measure_noise_gain();
   /// Adds the point unless outside the cut-offs, with its range per pixel (of the floor
   /// plane's range when `floor_ranged`, else of the stereo range).
   void add_point(int column, double range_m, double height_m, float inner_row, float outer_row,
@@ -100,6 +107,12 @@ class ScanReconstructor {
   std::vector<double> column_azimuth_rad_;
   vision::EdgeDetector inner_detector_;
   vision::EdgeDetector outer_detector_;
+  /// Per lobe and panorama row, the least high threshold per grey level of the frame's noise
+  /// (empty: no noise floor). See measure_noise_gain().
+  std::vector<float> inner_noise_gain_;
+  std::vector<float> outer_noise_gain_;
+  std::vector<float> noise_floor_;
+  vision::ImageAnnulus annulus_;
   LobeWork inner_;
   LobeWork outer_;
   std::vector<RowMatch> matches_;

@@ -20,6 +20,12 @@ struct CannyConfig {
   double auto_not_edge_fraction = 0.7;
   double auto_low_ratio = 0.4;
   double auto_min_high_threshold = 24.0;
+  /// Auto: no row's high threshold lies below the gradient magnitude that the frame's
+  /// sensor noise alone exceeds at this many pixels of a panorama (the noise measured on each
+  /// frame, vision/image_noise.hpp; its gradient follows a Rayleigh law of scale s, exceeding
+  /// s sqrt(2 ln(N / n)) at n of N pixels). So a dim, noisy frame keeps the edges that stand
+  /// out of its noise and no others. 0 turns the noise floor off.
+  double noise_edges_per_panorama = 1.0;
   int min_fragment_px = 6;  ///< 8-connected edge fragments smaller than this are noise
 };
 
