@@ -1,3 +1,4 @@
+#include <algorithm>
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <limits>
@@ -121,6 +122,26 @@ TEST_CASE(
     grid.add_scan(here, std::vector<Ray>{edge_here});
     seen_under(grid);
     CHECK(at(grid.image(), 2.05, 0.05) == 0);
+  }
+  SECTION("a grid resumed from its image (a snapshot) still keeps it; without the flags it did not") {
+    OccupancyGrid grid({.resolution_m = 0.1});
+    grid.add_scan(here, std::vector<Ray>{edge_here});
+    grid.add_scan(along, std::vector<Ray>{edge_along});
+    const GridImage saved = grid.image();
+    REQUIRE(saved.above_floor.size() == saved.cells.size());
+    CHECK(std::count(saved.above_floor.begin(), saved.above_floor.end(), 1) == 1);
+    OccupancyGrid resumed({.resolution_m = 0.1});
+    resumed.seed(saved);
+    CHECK(resumed.image().above_floor == saved.above_floor);
+    seen_under(resumed);
+    CHECK(at(resumed.image(), 2.05, 0.05) == 100);
+    GridImage unflagged = saved;  // as a map file or a version-4 snapshot gives it
+    unflagged.above_floor.clear();
+    OccupancyGrid forgetting({.resolution_m = 0.1});
+    forgetting.seed(unflagged);
+    seen_under(forgetting);
+    seen_under(forgetting);
+    CHECK(at(forgetting.image(), 2.05, 0.05) == 0);
   }
   SECTION(
       "a boundary on the floor (a wall's base, a person's feet) is cleared when the floor is seen there") {

@@ -158,13 +158,13 @@ TEST_CASE("snapshot: truncation, bit flips, other versions and bad values are re
 
 TEST_CASE("snapshot: a future version or impossible values are named even with a valid checksum",
           "[io][snapshot]") {
-  // A version-5 file (as a newer build would write it) has a valid CRC of its own.
-  std::vector<std::uint8_t> v5 = omnislam::io::encode_snapshot(example());
-  v5[8] = 5;
-  omnislam::test::reseal_snapshot(v5);
+  // A version-6 file (as a newer build would write it) has a valid CRC of its own.
+  std::vector<std::uint8_t> v6 = omnislam::io::encode_snapshot(example());
+  v6[8] = 6;
+  omnislam::test::reseal_snapshot(v6);
   CHECK_THROWS_WITH(
-      omnislam::io::decode_snapshot(v5, "v5.snap"),
-      Catch::Equals("v5.snap: unsupported snapshot version 5 (this build reads versions 1 to 4)"));
+      omnislam::io::decode_snapshot(v6, "v6.snap"),
+      Catch::Equals("v6.snap: unsupported snapshot version 6 (this build reads versions 1 to 5)"));
 
   Snapshot bad = example();
   bad.points[3].hits = 0;
@@ -237,26 +237,48 @@ omnislam::grid::GridImage example_grid() {
   g.resolution_m = 0.05;
   g.origin_m = {-1.25, 0.4};
   for (int i = 0; i < g.width * g.height; ++i) g.cells.push_back(i % 3 == 0 ? -1 : (i % 3 == 1 ? 0 : 100));
+  for (int i = 0; i < g.width * g.height; ++i)
+    g.above_floor.push_back(i % 6 == 2 ? 1 : 0);  // some occupied cells
   return g;
 }
 
 }  // namespace
 
-TEST_CASE("snapshot: the occupancy grid (since version 3) round-trips; version-3 and -2 files still read",
-          "[io][snapshot]") {
+TEST_CASE(
+    "snapshot: the occupancy grid (since version 3) round-trips with what stood above the floor "
+    "(since version 5); version-4, -3 and -2 files still read",
+    "[io][snapshot]") {
   Snapshot written = example();
   written.grid = example_grid();
-  const std::vector<std::uint8_t> v4 = omnislam::io::encode_snapshot(written);
-  CHECK(v4.size() == 24 + 200 + 24 * 50 + 8 + 32 + 21 + 8);
-  const Snapshot read = omnislam::io::decode_snapshot(v4, "grid.snap");
-  CHECK(read.version == 4);
+  const std::vector<std::uint8_t> v5 = omnislam::io::encode_snapshot(written);
+  CHECK(v5.size() == 24 + 200 + 24 * 50 + 8 + 32 + 21 + 21 + 8);
+  const Snapshot read = omnislam::io::decode_snapshot(v5, "grid.snap");
+  CHECK(read.version == 5);
   REQUIRE(read.grid);
   CHECK(read.grid->width == 7);
   CHECK(read.grid->height == 3);
   CHECK(read.grid->resolution_m == 0.05);
   CHECK(read.grid->origin_m == Eigen::Vector2d(-1.25, 0.4));
   CHECK(read.grid->cells == written.grid->cells);
+  CHECK(read.grid->above_floor == written.grid->above_floor);
   CHECK(read.points.size() == 50);
+  // A grid without flags (read from a map file) is written as none above the floor.
+  Snapshot unflagged = written;
+  unflagged.grid->above_floor.clear();
+  const Snapshot zeros =
+      omnislam::io::decode_snapshot(omnislam::io::encode_snapshot(unflagged), "zeros.snap");
+  CHECK(zeros.grid->above_floor == std::vector<std::uint8_t>(21, 0));
+
+  // Version 4: version 5 without the flags (the 21 bytes before has_graph), still read.
+  std::vector<std::uint8_t> v4 = v5;
+  v4.erase(v4.end() - 8 - 21, v4.end() - 8);
+  v4[8] = 4;
+  omnislam::test::reseal_snapshot(v4);
+  const Snapshot four = omnislam::io::decode_snapshot(v4, "v4.snap");
+  CHECK(four.version == 4);
+  REQUIRE(four.grid);
+  CHECK(four.grid->cells == written.grid->cells);
+  CHECK(four.grid->above_floor.empty());
 
   // Version 3: version 4 without the graph section (has_graph 0: 8 bytes), still read.
   std::vector<std::uint8_t> v3 = v4;
@@ -291,10 +313,18 @@ TEST_CASE("snapshot: the occupancy grid (since version 3) round-trips; version-3
   bad.grid = std::move(short_grid);
   CHECK_THROWS_WITH(
       omnislam::io::decode_snapshot(omnislam::io::encode_snapshot(bad), "short.snap"),
-      Catch::Contains("short.snap: the occupancy grid announces 21 cells, the file holds 20 bytes"));
+      Catch::Contains(
+          "short.snap: the occupancy grid announces 21 cells (42 bytes), the file holds 40 bytes"));
+  // A flag that is not 0 or 1 is named.
+  std::vector<std::uint8_t> odd_flag = v5;
+  const std::size_t flag_at = v5.size() - 8 - 21 + 4;  // cell 4's flag, before has_graph
+  odd_flag.at(flag_at) = 7;
+  omnislam::test::reseal_snapshot(odd_flag);
+  CHECK_THROWS_WITH(omnislam::io::decode_snapshot(odd_flag, "flag.snap"),
+                    Catch::Equals("flag.snap: occupancy grid cell 4 has above-floor flag 7 (not 0 or 1)"));
   // Every truncation of a file with a grid is caught too.
-  for (std::size_t length = v4.size() - 60; length < v4.size(); ++length) {
-    std::vector<std::uint8_t> cut(v4.begin(), v4.begin() + static_cast<long>(length));
+  for (std::size_t length = v5.size() - 80; length < v5.size(); ++length) {
+    std::vector<std::uint8_t> cut(v5.begin(), v5.begin() + static_cast<long>(length));
     omnislam::test::reseal_snapshot(cut);
     CHECK_THROWS_AS(omnislam::io::decode_snapshot(cut, "cut.snap"), SnapshotError);
   }
@@ -351,7 +381,7 @@ void put_u64(std::vector<std::uint8_t> &bytes, std::size_t at, std::uint64_t v) 
 
 }  // namespace
 
-TEST_CASE("snapshot: version 4 carries the keyframe graph exactly; re-encoding gives the same bytes",
+TEST_CASE("snapshot: version 4 and later carry the keyframe graph exactly; re-encoding gives the same bytes",
           "[io][snapshot]") {
   Snapshot written = example_with_graph();
   written.grid = example_grid();
@@ -359,9 +389,9 @@ TEST_CASE("snapshot: version 4 carries the keyframe graph exactly; re-encoding g
   // The graph section: 8 (has_graph) + 32 + 3 keyframes x (40 + 40 scans x (8 + 3 x 16))
   // + 8 + 120 x 8 + 8 + 3 x 112.
   CHECK(bytes.size() ==
-        24 + 200 + 24 * 50 + 8 + 32 + 21 + 8 + 32 + 8 + 3 * (40 + 40 * 56) + 8 + 960 + 8 + 336);
+        24 + 200 + 24 * 50 + 8 + 32 + 21 + 21 + 8 + 32 + 8 + 3 * (40 + 40 * 56) + 8 + 960 + 8 + 336);
   const Snapshot read = omnislam::io::decode_snapshot(bytes, "graph.snap");
-  CHECK(read.version == 4);
+  CHECK(read.version == 5);
   REQUIRE(read.grid);
   REQUIRE(read.graph);
   const KeyframeGraphState &want = *written.graph, &got = *read.graph;

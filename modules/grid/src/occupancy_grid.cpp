@@ -87,13 +87,16 @@ void OccupancyGrid::add_scan(const Eigen::Isometry2d &T_map_base, std::span<cons
 
 void OccupancyGrid::seed(const GridImage &start) {
   const Eigen::Vector2i low = (start.origin_m / config_.resolution_m).array().round().cast<int>();
+  const bool flagged = start.above_floor.size() == start.cells.size();
   for (int y = 0; y < start.height; ++y) {
     for (int x = 0; x < start.width; ++x) {
-      const std::int8_t cell =
-          start.cells[static_cast<std::size_t>(y) * static_cast<std::size_t>(start.width) +
-                      static_cast<std::size_t>(x)];
+      const std::size_t index =
+          static_cast<std::size_t>(y) * static_cast<std::size_t>(start.width) + static_cast<std::size_t>(x);
+      const std::int8_t cell = start.cells[index];
       // Unknown cells too (at even odds): the grid keeps the extent it had.
-      cells_[key(low + Cell(x, y))].log_odds = cell == 100 ? max_ : (cell == 0 ? min_ : 0.0f);
+      CellState &state = cells_[key(low + Cell(x, y))];
+      state.log_odds = cell == 100 ? max_ : (cell == 0 ? min_ : 0.0f);
+      state.above_floor = flagged && start.above_floor[index] != 0;
     }
   }
 }
@@ -113,13 +116,15 @@ GridImage OccupancyGrid::image() const {
   image.height = high.y() - low.y() + 1;
   image.origin_m = low.cast<double>() * config_.resolution_m;
   image.cells.assign(static_cast<std::size_t>(image.width) * static_cast<std::size_t>(image.height), -1);
+  image.above_floor.assign(image.cells.size(), 0);
   const float occupied = log_odds_of(config_.occupied_threshold), free = log_odds_of(config_.free_threshold);
   for (const auto &[cell_key, state] : cells_) {
     const int x = static_cast<int>(static_cast<std::int32_t>(cell_key >> 32)) - low.x();
     const int y = static_cast<int>(static_cast<std::int32_t>(cell_key & 0xffffffffu)) - low.y();
-    std::int8_t &cell = image.cells[static_cast<std::size_t>(y) * static_cast<std::size_t>(image.width) +
-                                    static_cast<std::size_t>(x)];
-    cell = state.log_odds >= occupied ? 100 : (state.log_odds <= free ? 0 : -1);
+    const std::size_t index =
+        static_cast<std::size_t>(y) * static_cast<std::size_t>(image.width) + static_cast<std::size_t>(x);
+    image.cells[index] = state.log_odds >= occupied ? 100 : (state.log_odds <= free ? 0 : -1);
+    image.above_floor[index] = state.above_floor ? 1 : 0;
   }
   return image;
 }

@@ -57,6 +57,10 @@ struct GridImage {
   double resolution_m = 0.05;
   Eigen::Vector2d origin_m = Eigen::Vector2d::Zero();
   std::vector<std::int8_t> cells;
+  /// Per cell in the layout of `cells`, 1 where something above the floor was seen from two
+  /// viewpoints (floor seen under it no longer clears it), else 0; empty when not known (a
+  /// grid read from a map file). Not part of nav_msgs/OccupancyGrid: kept for resuming.
+  std::vector<std::uint8_t> above_floor;
 };
 
 class OccupancyGrid {
@@ -68,8 +72,9 @@ class OccupancyGrid {
 
   /// Starts from a trinary grid (a resumed snapshot's): its occupied cells at the
   /// max_probability bound, its free cells at min_probability, its unknown cells at even
-  /// odds, so that image() gives it back (extent included) until new scans change it. Cells are matched by
-  /// position; `start` should have this grid's resolution.
+  /// odds, and the cells it marks above the floor as confirmed, so that image() gives it back
+  /// (extent included) until new scans change it. Cells are matched by position; `start`
+  /// should have this grid's resolution.
   void seed(const GridImage &start);
 
   /// The trinary grid over every cell observed so far (empty when none is).

@@ -17,11 +17,11 @@
 /// Snapshots of the SLAM state (map, pose, counters, configuration hash) that a service
 /// writes periodically into its state directory and resumes from after a restart.
 ///
-/// File format, version 4 (all integers and doubles little-endian):
+/// File format, version 5 (all integers and doubles little-endian):
 /// ```
 /// offset  size  field
 ///  0       8    magic "OMNISNAP"
-///  8       4    u32 format version (4)
+///  8       4    u32 format version (5)
 /// 12       8    u64 payload size in bytes
 /// 20       4    u32 CRC-32 (zlib) of bytes 8..19 followed by the payload
 /// 24       -    payload: u64 config_hash, f64 t_s, f64 x_m, f64 y_m, f64 yaw_rad,
@@ -31,7 +31,8 @@
 ///               u64 point count, then per point f64 x_m, f64 y_m, i32 hits, i32 first_seen,
 ///               u64 has_grid (0 or 1), and when 1: i32 width, i32 height, f64 resolution_m,
 ///               f64 origin x_m, f64 origin y_m, width x height i8 cells (-1, 0, 100; the
-///               layout of grid::GridImage),
+///               layout of grid::GridImage), width x height u8 above-floor flags (0, 1;
+///               grid::GridImage::above_floor),
 ///               u64 has_graph (0 or 1), and when 1 the keyframe graph
 ///               (slam::KeyframeGraphState): f64 path_m, f64 last frame x_m, y_m, yaw_rad,
 ///               u64 keyframe count, per keyframe f64 x_m, f64 y_m, f64 yaw_rad, f64 path_m,
@@ -41,13 +42,14 @@
 ///               u32 to, u64 loop (0 or 1), f64 x_m, f64 y_m, f64 yaw_rad (pose of `to` in
 ///               `from`), 9 x f64 information (row-major, x y yaw)
 /// ```
-/// Version 3 is version 4 without the graph section, version 2 version 3 without the grid
-/// section, version 1 version 2 without the four odometry fields; all are still read
-/// (their `graph`, and before version 3 their `grid`, are empty).
+/// Version 4 is version 5 without the grid's above-floor flags, version 3 version 4 without
+/// the graph section, version 2 version 3 without the grid section, version 1 version 2
+/// without the four odometry fields; all are still read (their grid's `above_floor`, before
+/// version 4 their `graph`, and before version 3 their `grid`, are empty).
 
 namespace omnislam::io {
 
-inline constexpr std::uint32_t kSnapshotVersion = 4;
+inline constexpr std::uint32_t kSnapshotVersion = 5;
 
 /// A snapshot that cannot be used: missing, truncated, of another version, failing its
 /// checksum, or holding impossible values. The message names the file.
@@ -78,7 +80,8 @@ struct Snapshot {
   int map_integrations = 0;  ///< slam::PointMap::integrations() (the age reference of first_seen)
   std::vector<slam::MapPoint> points;
   /// The trinary occupancy grid (free space included) of the same state, when the writer
-  /// had one (version 3); a resumed service does not rebuild its log-odds from it.
+  /// had one (version 3), with what stood above the floor (version 5); a resumed service
+  /// starts its grid from it (grid::OccupancyGrid::seed).
   std::optional<grid::GridImage> grid;
   /// The keyframe graph the map was built from, when the writer's graph described the map
   /// (version 4; slam::Slam::graph_state): a resumed run continues it and can close loops
