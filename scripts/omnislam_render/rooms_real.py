@@ -11,7 +11,7 @@ from __future__ import annotations
 
 from .rooms import (BOXES, CABINET, CEILING, DOOR, TABLE_FOOT, TABLE_TOP, WALLS, WINDOW, building_floor, l_room,
                     sim_room)
-from .scene import AreaLamp, Box, Cable, Cylinder, Patch, Room, Rug, Skirting, Sphere, Sun
+from .scene import AreaLamp, Box, Cable, Cylinder, Patch, Pit, Room, Rug, Skirting, Sphere, Sun
 
 # Indirect light is approximated by a low ambient term; the lamps do the rest.
 FINISH = "finish { ambient 0.12 diffuse 0.8 }"
@@ -226,6 +226,20 @@ def home_room() -> Room:
         Cable("lamp cable", [(0.55, 0.5), (0.95, 0.62), (1.35, 0.58), (1.7, 0.35), (1.8, 0.02)], 0.003,
               (0.05, 0.05, 0.05)),
     ]
+    return room
+
+
+def home_step_room() -> Room:
+    """A held-out scene (not bundled): the living room with a sunken seating area instead of
+    its low table and rug, 1.5 x 0.9 m and 0.18 m deep (one step down, no railing), in pale oak
+    like the rest of the floor; the robot passes its edges 0.7 m away. A drop, not a wall: the
+    floor beyond its edge goes on, lower."""
+    room = home_room()
+    room.name = "home-step"
+    room.objects = [o for o in room.objects if not o.name.startswith("low table")]
+    room.rugs = []
+    room.cables = [c for c in room.cables if c.name != "extension lead"]
+    room.pits = [Pit("sunken area", (2.4, 1.8), (3.9, 2.7), 0.18)]
     return room
 
 

@@ -169,6 +169,26 @@ class Rug:
 
 
 @dataclass
+class Pit:
+    """A part of the floor lower than the rest (a sunken seating area, a step down, a stairwell
+    without its railing), its bottom and sides in the floor's material: a drop the robot must
+    not drive over, so the floor plan draws its edge."""
+    name: str
+    lo: tuple[float, float]
+    hi: tuple[float, float]
+    depth: float
+
+    def outline(self) -> list[Segment]:
+        (x0, y0), (x1, y1) = self.lo, self.hi
+        return polygon_segments([(x0, y0), (x1, y0), (x1, y1), (x0, y1)])
+
+    def distance_xy(self, x: float, y: float) -> float:
+        dx = max(self.lo[0] - x, 0.0, x - self.hi[0])
+        dy = max(self.lo[1] - y, 0.0, y - self.hi[1])
+        return math.hypot(dx, dy)
+
+
+@dataclass
 class Cable:
     """A cable lying loose on the floor along a polyline (x, y in m): a dark or light line
     a few millimetres high that a robot drives over; floor texture, not an obstacle (not in
@@ -213,6 +233,7 @@ class Room:
     rugs: list[Rug] = field(default_factory=list)
     skirting: Skirting | None = None
     cables: list[Cable] = field(default_factory=list)
+    pits: list[Pit] = field(default_factory=list)
 
     # ---------------------------------------------------------------- geometry
     def walls(self) -> list[Segment]:
@@ -226,7 +247,7 @@ class Room:
 
     def floorplan(self) -> list[Segment]:
         segs = list(self.inner_faces())
-        for obj in self.objects:
+        for obj in [*self.objects, *self.pits]:
             segs.extend(obj.outline())
         return segs
 
@@ -238,7 +259,7 @@ class Room:
             t = max(0.0, min(1.0, ((x - x1) * dx + (y - y1) * dy) / (dx * dx + dy * dy)))
             d = math.hypot(x - x1 - t * dx, y - y1 - t * dy)
             best = min(best, (d, f"wall {i}"))
-        for obj in self.objects:
+        for obj in [*self.objects, *self.pits]:
             best = min(best, (obj.distance_xy(x, y), obj.name))
         return best
 
@@ -310,8 +331,13 @@ class Room:
         """The room in world coordinates (mm), without the pose transform."""
         floor = self.floor_texture or f"pigment {{ {_rgb(self.floor_colour)} }} {self.finish}"
         ceiling_shadow = " no_shadow" if self.sun is not None else ""
+        floor_solid = f"plane {{ z, 0 {floor} }}  // floor"
+        if self.pits:  # the floor with the pits cut out: their bottoms and sides in its material
+            cuts = " ".join(f"box {{ {vec(*_mm(*pit.lo, -pit.depth))}, {vec(*_mm(*pit.hi, 1.0))} }}"
+                            for pit in self.pits)
+            floor_solid = f"difference {{ plane {{ z, 0 }} {cuts} {floor} }}  // floor with {len(self.pits)} pit(s)"
         parts = [
-            f"plane {{ z, 0 {floor} }}  // floor",
+            floor_solid,
             f"plane {{ -z, {num(-self.height * 1000)} pigment {{ {_rgb(self.ceiling_colour)} }} "
             f"{self.finish}{ceiling_shadow} }}  // ceiling",
         ]

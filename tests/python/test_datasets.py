@@ -457,6 +457,22 @@ def test_home_cables_lie_on_the_floor_outside_the_plan_and_cross_the_path():
     assert spec.camera_height_m == 1.05 and spec.grey
 
 
+def test_home_step_pit_is_cut_into_the_floor_and_drawn_in_the_plan():
+    # The held-out sunken area: the floor is a plane with a box cut out (bottom and sides in
+    # the floor's material), its edge is in the floor plan and the path stays clear of it.
+    spec = datasets.HELD_OUT["home-step"]
+    room, world = spec.room(), spec.world_poses()
+    (pit,) = room.pits
+    floor = next(line for line in room.pov_body().splitlines() if line.strip().endswith("pit(s)"))
+    assert floor.startswith("difference { plane { z, 0 } box { <2400.0, 1800.0, -180.0>, <3900.0, 2700.0, 1000.0> }")
+    assert room.floor_texture in floor
+    plan = {tuple(round(v, 6) for v in seg) for seg in room.floorplan()}
+    assert {tuple(round(v, 6) for v in seg) for seg in pit.outline()} <= plan
+    assert room.clearance(3.0, 2.2) == (0.0, "sunken area")
+    assert min(room.clearance(x, y)[0] for x, y, _ in world) >= 0.4
+    assert not any(o.name.startswith("low table") for o in room.objects) and not room.rugs
+
+
 def test_frames_option_limits_metadata(tmp_path):
     out = tmp_path / "ds"
     subprocess.run(RENDER + ["l-room-2laps", "--out", str(out), "--frames", "7", "--no-images"],
