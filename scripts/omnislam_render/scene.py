@@ -51,6 +51,19 @@ def inset_outline(points: Sequence[tuple[float, float]], depth: float) -> list[t
     return out
 
 
+def rectangle_segments(lo: Sequence[float], hi: Sequence[float]) -> list[Segment]:
+    """The plan outline of an axis-aligned rectangle from its (x, y) corners."""
+    (x0, y0), (x1, y1) = lo[:2], hi[:2]
+    return polygon_segments([(x0, y0), (x1, y0), (x1, y1), (x0, y1)])
+
+
+def rectangle_distance(lo: Sequence[float], hi: Sequence[float], x: float, y: float) -> float:
+    """Plan distance from (x, y) to an axis-aligned rectangle (0 inside it)."""
+    dx = max(lo[0] - x, 0.0, x - hi[0])
+    dy = max(lo[1] - y, 0.0, y - hi[1])
+    return math.hypot(dx, dy)
+
+
 def circle_segments(cx: float, cy: float, r: float, sides: int = CIRCLE_SIDES) -> list[Segment]:
     """Polygon with `sides` vertices on the circle (a cylinder's plan outline)."""
     pts = [(cx + r * math.cos(2 * math.pi * i / sides), cy + r * math.sin(2 * math.pi * i / sides))
@@ -70,13 +83,10 @@ class Box:
                 f"pigment {{ {_rgb(self.colour)} }} {finish} }}  // {self.name}")
 
     def outline(self) -> list[Segment]:
-        (x0, y0, _), (x1, y1, _) = self.lo, self.hi
-        return polygon_segments([(x0, y0), (x1, y0), (x1, y1), (x0, y1)])
+        return rectangle_segments(self.lo[:2], self.hi[:2])
 
     def distance_xy(self, x: float, y: float) -> float:
-        dx = max(self.lo[0] - x, 0.0, x - self.hi[0])
-        dy = max(self.lo[1] - y, 0.0, y - self.hi[1])
-        return math.hypot(dx, dy)
+        return rectangle_distance(self.lo[:2], self.hi[:2], x, y)
 
 
 @dataclass
@@ -179,13 +189,10 @@ class Pit:
     depth: float
 
     def outline(self) -> list[Segment]:
-        (x0, y0), (x1, y1) = self.lo, self.hi
-        return polygon_segments([(x0, y0), (x1, y0), (x1, y1), (x0, y1)])
+        return rectangle_segments(self.lo, self.hi)
 
     def distance_xy(self, x: float, y: float) -> float:
-        dx = max(self.lo[0] - x, 0.0, x - self.hi[0])
-        dy = max(self.lo[1] - y, 0.0, y - self.hi[1])
-        return math.hypot(dx, dy)
+        return rectangle_distance(self.lo, self.hi, x, y)
 
 
 @dataclass
