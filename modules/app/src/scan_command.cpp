@@ -1,5 +1,6 @@
 #include "scan_command.hpp"
 #include <algorithm>
+#include <limits>
 
 #include <cstdio>
 #include <memory>
@@ -33,12 +34,15 @@ void print_csv(const stereo::LocalScan &scan) {
   }
 }
 
-// Free floor per panorama column (floor-boundary scans): "nan" where nothing was seen.
+// Free floor per panorama column (floor-boundary scans), and where it ended in a drop: "nan"
+// where nothing was seen.
 void print_free_csv(const stereo::LocalScan &scan, const mirror::MirrorConfig &camera) {
-  std::printf("azimuth_deg,free_range_m\n");
+  std::printf("azimuth_deg,free_range_m,drop_range_m\n");
   for (std::size_t column = 0; column < scan.free_range_m.size(); ++column) {
     const double azimuth_deg = mirror::column_azimuth_rad(camera, static_cast<int>(column)) * kDegPerRad;
-    std::printf("%.3f,%.4f\n", azimuth_deg, static_cast<double>(scan.free_range_m[column]));
+    const double drop_m = column < scan.drop_range_m.size() ? static_cast<double>(scan.drop_range_m[column])
+                                                            : std::numeric_limits<double>::quiet_NaN();
+    std::printf("%.3f,%.4f,%.4f\n", azimuth_deg, static_cast<double>(scan.free_range_m[column]), drop_m);
   }
 }
 
@@ -58,9 +62,10 @@ void print_summary(const std::string &image, const stereo::LocalScan &scan) {
   if (!scan.free_range_m.empty()) {
     std::fprintf(stderr,
                  "%s: floor boundary: floor texture %d, floor contacts %d (undecided %d), elevated %d, "
-                 "unexplained %d, residual scale %.4f, twin spread %.3f px\n",
+                 "unexplained %d, drops %d, residual scale %.4f, twin spread %.3f px\n",
                  image.c_str(), s.floor_texture_edges, s.floor_contacts, s.undecided, s.elevated,
-                 s.unexplained, static_cast<double>(s.noise_scale), static_cast<double>(s.twin_spread_px));
+                 s.unexplained, s.drops, static_cast<double>(s.noise_scale),
+                 static_cast<double>(s.twin_spread_px));
   }
 }
 

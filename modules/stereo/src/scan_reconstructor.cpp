@@ -168,9 +168,10 @@ void ScanReconstructor::match() {
   matches_.clear();
   match_stats_ = {};
   if (floor_boundary()) {
-    boundary_stats_ = boundary_finder_.find(floor_geometry_, inner_.texture, outer_.texture, inner_.edges,
-                                            outer_.edges, inner_.candidates, outer_.candidates, limits_,
-                                            triangulator_, selection_, boundary_points_, free_range_m_);
+    boundary_stats_ =
+        boundary_finder_.find(floor_geometry_, inner_.texture, outer_.texture, inner_.edges, outer_.edges,
+                              inner_.candidates, outer_.candidates, limits_, triangulator_, selection_,
+                              boundary_points_, free_range_m_, drop_range_m_);
     return;
   }
   for (int column = 0; column < inner_.candidates.columns(); ++column) {
@@ -257,12 +258,15 @@ void ScanReconstructor::build_boundary_scan(LocalScan &scan) {
     scan.stats.filtered_out = keep_nearest_per_degree(scan.points, filtered_);
   scan.stats.points = static_cast<int>(scan.points.size());
   scan.free_range_m = free_range_m_;
+  scan.drop_range_m = drop_range_m_;
+  scan.stats.drops = boundary_stats_.drops;
 }
 
 void ScanReconstructor::build_scan(const std::vector<RowMatch> &matches, LocalScan &scan) {
   const StereoConfig &stereo = config_.stereo;
   scan.points.clear();
   scan.free_range_m.clear();
+  scan.drop_range_m.clear();
   for (const RowMatch &match : matches) {
     const auto point = triangulator_.triangulate(match.column, match.inner_row, match.outer_row);
     if (!point) {

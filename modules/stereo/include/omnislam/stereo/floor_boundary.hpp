@@ -1,5 +1,6 @@
 #pragma once
 
+#include <cstdint>
 #include <limits>
 #include <opencv2/core.hpp>
 #include <span>
@@ -74,6 +75,7 @@ struct BoundaryStats {
   int undecided = 0;            ///< of which the test ran out of rows
   int elevated = 0;             ///< boundaries above the floor (triangulated)
   int unexplained = 0;          ///< edges off the floor without an outer match
+  int drops = 0;                ///< of which below the floor: a lower floor past a step down
   float noise_scale = 0.0f;     ///< residual scale used by the test (intensity in [0, 1])
   float twin_spread_px = 0.0f;  ///< the lobes' sub-pixel placement error (Laplace scale, rows)
 };
@@ -85,13 +87,16 @@ class FloorBoundaryFinder {
 
   /// Finds the boundary of every column. `inner`/`outer` textures are CV_32FC1 in [0, 1];
   /// the candidates are every horizontal edge of each column, nearest first.
-  /// `free_range_m` gets, per column, how far the floor was seen to be free (NaN: unknown).
+  /// `free_range_m` gets, per column, how far the floor was seen to be free (NaN: unknown);
+  /// `drop_range_m` where a lower floor seen beyond showed the floor ending before any
+  /// boundary (the floor level's range of the ray that reached it; NaN: none).
   BoundaryStats find(const FloorGeometry &geometry, const cv::Mat &inner_texture,
                      const cv::Mat &outer_texture, const vision::EdgeImage &inner_edges,
                      const vision::EdgeImage &outer_edges, const vision::ColumnEdges &inner_candidates,
                      const vision::ColumnEdges &outer_candidates, const DisparityLimits &limits,
                      const RowTriangulator &triangulator, const vision::EdgeSelectionConfig &window,
-                     std::vector<BoundaryPoint> &points, std::vector<float> &free_range_m);
+                     std::vector<BoundaryPoint> &points, std::vector<float> &free_range_m,
+                     std::vector<float> &drop_range_m);
 
  private:
   /// Smoothed column-major textures, the lobes' gain, the floor residuals, the noise scale.
@@ -111,6 +116,13 @@ class FloorBoundaryFinder {
   [[nodiscard]] bool floor_seen_beyond(std::size_t index, float contact_row, double rows_llr) const;
   /// The current column's outer edge of polarity `sign` nearest `outer_row` and its offset
   /// from it (nullptr and infinity when the column has none).
+  /// Whether edge `index` of the current column is a surface below the floor: its nearest
+  /// same-polarity outer edge below the floor's row, beyond the contact margin, triangulates
+  /// under the floor plane.
+  [[nodiscard]] bool below_floor(int column, std::size_t index, float floor_row, double floor_height_m,
+                                 const RowTriangulator &triangulator) const;
+  std::vector<float> drop_floor_m_;      ///< per column, how far the floor was seen before its drop
+  std::vector<std::uint8_t> kept_drop_;  ///< per column, whether its drop has a like one beside it
   struct Twin {
     const vision::EdgePoint *edge = nullptr;
     float offset = std::numeric_limits<float>::infinity();

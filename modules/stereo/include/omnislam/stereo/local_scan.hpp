@@ -61,6 +61,7 @@ struct ScanStats {
   int undecided = 0;            ///< of which neither hypothesis won (uniform surfaces)
   int elevated = 0;             ///< boundaries above the floor (triangulated)
   int unexplained = 0;          ///< edges off the floor without an outer match
+  int drops = 0;                ///< of which below the floor (a lower floor past a step down)
   float noise_scale = 0.0f;     ///< photometric residual scale (intensity in [0, 1])
   /// Sub-pixel placement error of the frame's edges (rows, Laplace scale): the spread of floor
   /// edges' outer twins about where the floor puts them.
@@ -82,6 +83,11 @@ struct LocalScan {
   /// was seen to be free (m): up to the boundary found, or up to the farthest floor texture where none was;
   /// NaN where nothing was seen. Empty for the nearest-edge method.
   std::vector<float> free_range_m;
+  /// Per panorama column, where the floor ended in a drop before any boundary: a lower floor
+  /// (past a step down) was seen beyond, and this is the range at which the ray that reached
+  /// it crossed the floor's level (the step's rim is nearer). NaN where none was seen; empty
+  /// for the nearest-edge method. Not scan points: what lies there depends on the viewpoint.
+  std::vector<float> drop_range_m;
   ScanStats stats;
 };
 

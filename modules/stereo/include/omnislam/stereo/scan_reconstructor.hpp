@@ -120,6 +120,7 @@ class ScanReconstructor {
   FloorBoundaryFinder boundary_finder_;
   std::vector<BoundaryPoint> boundary_points_;
   std::vector<float> free_range_m_;
+  std::vector<float> drop_range_m_;
   BoundaryStats boundary_stats_;
   std::vector<ScanPoint> filtered_;
 };
