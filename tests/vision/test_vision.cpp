@@ -352,10 +352,10 @@ TEST_CASE("image noise: a frame's noise deviation, whatever its edges, texture a
   const cv::Mat scene = structured_frame();
   const ImageAnnulus annulus;
   // Noise-free: the edges, tiles and ramp alone read as (almost) no noise.
-  CHECK(image_noise_dn(scene, annulus) < 0.6);
+  CHECK(ImageNoiseMeter(annulus).measure(scene) < 0.6);
   for (const double deviation : {2.0, 5.0, 10.0, 20.0}) {
     INFO("noise deviation " << deviation);
-    const double estimate = image_noise_dn(with_noise(scene, deviation, 11), annulus);
+    const double estimate = ImageNoiseMeter(annulus).measure(with_noise(scene, deviation, 11));
     CHECK(estimate == Approx(deviation).epsilon(0.1).margin(0.3));  // 8-bit rounding adds 0.29
   }
   // Only the annulus counts: noise outside it does not, inside it does.
@@ -364,9 +364,9 @@ TEST_CASE("image noise: a frame's noise deviation, whatever its edges, texture a
   cv::Mat ring_mask(scene.size(), CV_8UC1, cv::Scalar(255));
   cv::circle(ring_mask, {512, 512}, 500, cv::Scalar(0), cv::FILLED);
   noisy.copyTo(outside, ring_mask);
-  CHECK(image_noise_dn(outside, annulus) < 0.6);
-  CHECK(image_noise_dn(cv::Mat::zeros(1024, 1024, CV_8UC1), annulus) == 0.0);
-  CHECK(image_noise_dn(noisy, {{511.5, 511.5}, 0.0, 0.0}) == 0.0);  // an empty annulus
+  CHECK(ImageNoiseMeter(annulus).measure(outside) < 0.6);
+  CHECK(ImageNoiseMeter(annulus).measure(cv::Mat::zeros(1024, 1024, CV_8UC1)) == 0.0);
+  CHECK(ImageNoiseMeter({{511.5, 511.5}, 0.0, 0.0}).measure(noisy) == 0.0);  // an empty annulus
 }
 
 TEST_CASE("Canny's noise floor: a row's high threshold rises to what the noise reaches there",

@@ -1,8 +1,8 @@
 #include "scan_command.hpp"
-#include <algorithm>
-#include <limits>
 
+#include <algorithm>
 #include <cstdio>
+#include <limits>
 #include <memory>
 #include <numbers>
 #include <stdexcept>

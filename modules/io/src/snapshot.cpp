@@ -137,7 +137,7 @@ std::optional<grid::GridImage> decode_grid(ByteReader &in, const std::string &na
   const std::uint64_t cells = static_cast<std::uint64_t>(g.width) * static_cast<std::uint64_t>(g.height);
   const std::uint64_t bytes = with_above_floor ? 2 * cells : cells;
   const std::uint64_t available = in.remaining() >= trailing ? in.remaining() - trailing : 0;
-  if (cells > available || (trailing == 0 ? available != bytes : available < bytes)) {
+  if (trailing == 0 ? available != bytes : available < bytes) {
     throw SnapshotError(name + ": the occupancy grid announces " + std::to_string(cells) + " cells (" +
                         std::to_string(bytes) + " bytes), the file holds " + std::to_string(available) +
                         " bytes");

@@ -488,6 +488,35 @@ float FloorBoundaryFinder::floor_seen_outer_row(float farthest_floor_row) const 
   return std::isfinite(row) ? row : std::numeric_limits<float>::infinity();
 }
 
+int FloorBoundaryFinder::keep_drops_beside_drops(std::vector<float> &free_range_m,
+                                                 std::vector<float> &drop_range_m) {
+  // A drop's rim runs on across the columns beside it; a twin below the floor by chance (a
+  // floor edge whose own twin was missed: 30-70 a frame in any room) does not. A column's drop
+  // stands when a column beside it saw one at a like range (within 10%: a rim seen one degree
+  // further round moves by a few percent at the angles the camera sees it).
+  const int columns = static_cast<int>(drop_range_m.size());
+  const auto alike = [&](int column, float range_m) {
+    const float other = drop_range_m[static_cast<std::size_t>((column + columns) % columns)];
+    return std::isfinite(other) && std::abs(other - range_m) <= kDropAlike * range_m;
+  };
+  kept_drop_.assign(static_cast<std::size_t>(columns), 0);
+  for (int column = 0; column < columns; ++column) {
+    const float range_m = drop_range_m[static_cast<std::size_t>(column)];
+    kept_drop_[static_cast<std::size_t>(column)] =
+        std::isfinite(range_m) && (alike(column - 1, range_m) || alike(column + 1, range_m));
+  }
+  int kept = 0;
+  for (std::size_t c = 0; c < drop_range_m.size(); ++c) {
+    if (!kept_drop_[c]) {
+      drop_range_m[c] = kNaN;
+      continue;
+    }
+    ++kept;
+    if (std::isfinite(free_range_m[c])) free_range_m[c] = std::min(free_range_m[c], drop_floor_m_[c]);
+  }
+  return kept;
+}
+
 BoundaryStats FloorBoundaryFinder::find(const FloorGeometry &geometry, const cv::Mat &inner_texture,
                                         const cv::Mat &outer_texture, const vision::EdgeImage &inner_edges,
                                         const vision::EdgeImage &outer_edges,
@@ -684,30 +713,7 @@ BoundaryStats FloorBoundaryFinder::find(const FloorGeometry &geometry, const cv:
       drop_floor_m_[static_cast<std::size_t>(column)] = floor_before_drop_m;
     }
   }
-  // A drop's rim runs on across the columns beside it; a twin below the floor by chance (a
-  // floor edge whose own twin was missed: 30-70 a frame in any room) does not. A column's drop
-  // stands when a column beside it saw one at a like range (within 10%: a rim seen one degree
-  // further round moves by a few percent at the angles the camera sees it).
-  const int columns = inner_candidates.columns();
-  const auto alike = [&](int column, float range_m) {
-    const float other = drop_range_m[static_cast<std::size_t>((column + columns) % columns)];
-    return std::isfinite(other) && std::abs(other - range_m) <= kDropAlike * range_m;
-  };
-  kept_drop_.assign(static_cast<std::size_t>(columns), 0);
-  for (int column = 0; column < columns; ++column) {
-    const float range_m = drop_range_m[static_cast<std::size_t>(column)];
-    kept_drop_[static_cast<std::size_t>(column)] =
-        std::isfinite(range_m) && (alike(column - 1, range_m) || alike(column + 1, range_m));
-  }
-  for (int column = 0; column < columns; ++column) {
-    const auto c = static_cast<std::size_t>(column);
-    if (!kept_drop_[c]) {
-      drop_range_m[c] = kNaN;
-      continue;
-    }
-    ++stats.drops;
-    if (std::isfinite(free_range_m[c])) free_range_m[c] = std::min(free_range_m[c], drop_floor_m_[c]);
-  }
+  stats.drops = keep_drops_beside_drops(free_range_m, drop_range_m);
   return stats;
 }
 

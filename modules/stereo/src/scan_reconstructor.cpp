@@ -83,9 +83,10 @@ ScanReconstructor::ScanReconstructor(const ScanConfig &config)
     column_sin_.push_back(std::sin(azimuth));
   }
   matches_.reserve(static_cast<std::size_t>(config.camera.columns) * 4);
-  annulus_ = {{config.camera.center_u_px, config.camera.center_v_px},
-              static_cast<double>(config.camera.discard_px),
-              static_cast<double>(config.camera.discard_px + 2 * config.camera.rows_per_lobe)};
+  noise_meter_ = vision::ImageNoiseMeter(
+      {{config.camera.center_u_px, config.camera.center_v_px},
+       static_cast<double>(config.camera.discard_px),
+       static_cast<double>(config.camera.discard_px + 2 * config.camera.rows_per_lobe)});
   if (config.vision.canny.auto_thresholds && config.vision.canny.noise_edges_per_panorama > 0.0)
     measure_noise_gain();
 }
@@ -141,7 +142,7 @@ void ScanReconstructor::unwarp(const cv::Mat &image) {
   unwarper_.unwarp(image, mirror::Lobe::kInner, inner_.panorama);
   unwarper_.prefetch(image, mirror::Lobe::kOuter);
   unwarper_.unwarp(image, mirror::Lobe::kOuter, outer_.panorama);
-  const double noise_dn = inner_noise_gain_.empty() ? 0.0 : vision::image_noise_dn(image, annulus_);
+  const double noise_dn = inner_noise_gain_.empty() ? 0.0 : noise_meter_.measure(image);
   inner_.image_noise_dn = noise_dn;
   outer_.image_noise_dn = noise_dn;
 }

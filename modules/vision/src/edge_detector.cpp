@@ -209,32 +209,30 @@ void EdgeDetector::trace_edges(EdgeImage &out) {
 }
 
 void EdgeDetector::choose_thresholds(EdgeImage &out, std::span<const float> noise_floor) {
-  const int rows = out.grad_row.rows;
-  // Thresholds beyond any magnitude are capped (as cv::Canny does) so that squares fit.
+  if (config_.auto_thresholds) {
+    choose_auto_thresholds(out);
+  } else {
+    out.high_threshold = config_.high_threshold;
+    out.low_threshold = config_.low_threshold;
+  }
+  // Each row's high threshold is at least what the frame's noise reaches there (automatic
+  // thresholds only), its low one following at auto_low_ratio. Thresholds beyond any
+  // magnitude are capped (as cv::Canny does) so that squares fit.
   const auto squared = [](double threshold) {
     const double capped = std::min(threshold, kMaxThreshold);
     return static_cast<std::int32_t>(std::floor(capped * capped));
   };
+  const auto rows = static_cast<std::size_t>(out.grad_row.rows);
+  const bool floored = config_.auto_thresholds && noise_floor.size() == rows;
   out.noise_high_threshold = 0.0;
-  if (!config_.auto_thresholds) {
-    out.high_threshold = config_.high_threshold;
-    out.low_threshold = config_.low_threshold;
-    row_low_sq_.assign(static_cast<std::size_t>(rows), squared(out.low_threshold));
-    row_high_sq_.assign(static_cast<std::size_t>(rows), squared(out.high_threshold));
-    return;
-  }
-  choose_auto_thresholds(out);
-  // Each row's high threshold is at least what the frame's noise reaches there.
-  row_low_sq_.resize(static_cast<std::size_t>(rows));
-  row_high_sq_.resize(static_cast<std::size_t>(rows));
-  const bool floored = static_cast<int>(noise_floor.size()) == rows;
-  for (int row = 0; row < rows; ++row) {
-    const double floor = floored ? static_cast<double>(noise_floor[static_cast<std::size_t>(row)]) : 0.0;
-    const double high = std::max(out.high_threshold, floor);
-    if (floor > out.high_threshold) out.noise_high_threshold = std::max(out.noise_high_threshold, floor);
-    row_high_sq_[static_cast<std::size_t>(row)] = squared(high);
-    row_low_sq_[static_cast<std::size_t>(row)] =
-        squared(high == out.high_threshold ? out.low_threshold : config_.auto_low_ratio * high);
+  row_low_sq_.resize(rows);
+  row_high_sq_.resize(rows);
+  for (std::size_t row = 0; row < rows; ++row) {
+    const double floor = floored ? static_cast<double>(noise_floor[row]) : 0.0;
+    const bool raised = floor > out.high_threshold;
+    if (raised) out.noise_high_threshold = std::max(out.noise_high_threshold, floor);
+    row_high_sq_[row] = squared(raised ? floor : out.high_threshold);
+    row_low_sq_[row] = squared(raised ? config_.auto_low_ratio * floor : out.low_threshold);
   }
 }
 

@@ -17,17 +17,17 @@ constexpr double kResponseGain = 12.0;  // deviation of the response on 2 x 2 su
 
 }  // namespace
 
-double image_noise_dn(const cv::Mat &image, const ImageAnnulus &annulus) {
+double ImageNoiseMeter::measure(const cv::Mat &image) {
   CV_Assert(image.type() == CV_8UC1);
+  const ImageAnnulus &annulus = annulus_;
   const int binned_rows = image.rows / 2, binned_cols = image.cols / 2;
   if (binned_rows < 3 || binned_cols < 3) return 0.0;
   // Binned pixel (i, j) holds raw pixels (2i..2i+1, 2j..2j+1); its centre is (2j + 0.5, 2i + 0.5).
-  std::array<std::vector<int>, 3> sums;
-  for (auto &row : sums) row.resize(static_cast<std::size_t>(binned_cols));
-  const auto bin_row = [&](int i, std::vector<int> &out) {
+  for (auto &row : sums_) row.resize(static_cast<std::size_t>(binned_cols));
+  const auto bin_row = [&](int i, int first, int last, std::vector<int> &out) {
     const std::uint8_t *a = image.ptr<std::uint8_t>(2 * i);
     const std::uint8_t *b = image.ptr<std::uint8_t>(2 * i + 1);
-    for (int j = 0; j < binned_cols; ++j)
+    for (int j = first; j <= last; ++j)
       out[static_cast<std::size_t>(j)] = a[2 * j] + a[2 * j + 1] + b[2 * j] + b[2 * j + 1];
   };
   std::array<int, kResponseBins> histogram{};
@@ -44,10 +44,10 @@ double image_noise_dn(const cv::Mat &image, const ImageAnnulus &annulus) {
     const int last = std::min(binned_cols - 2,
                               static_cast<int>(std::floor((annulus.centre_px.x + half_width - 0.5) / 2.0)));
     if (first > last) continue;
-    bin_row(i - 1, sums[0]);
-    bin_row(i, sums[1]);
-    bin_row(i + 1, sums[2]);
-    const int *up = sums[0].data(), *mid = sums[1].data(), *down = sums[2].data();
+    bin_row(i - 1, first - 1, last + 1, sums_[0]);
+    bin_row(i, first - 1, last + 1, sums_[1]);
+    bin_row(i + 1, first - 1, last + 1, sums_[2]);
+    const int *up = sums_[0].data(), *mid = sums_[1].data(), *down = sums_[2].data();
     for (int j = first; j <= last; ++j) {
       const double du = 2.0 * j + 0.5 - annulus.centre_px.x;
       if (du * du + dv * dv < inner_sq) continue;

@@ -121,6 +121,9 @@ class FloorBoundaryFinder {
   /// under the floor plane.
   [[nodiscard]] bool below_floor(int column, std::size_t index, float floor_row, double floor_height_m,
                                  const RowTriangulator &triangulator) const;
+  /// Keeps the drops a neighbouring column confirms (NaN for the others) and stops their
+  /// columns' free floor where it was seen before the drop; returns how many were kept.
+  int keep_drops_beside_drops(std::vector<float> &free_range_m, std::vector<float> &drop_range_m);
   std::vector<float> drop_floor_m_;      ///< per column, how far the floor was seen before its drop
   std::vector<std::uint8_t> kept_drop_;  ///< per column, whether its drop has a like one beside it
   struct Twin {

@@ -112,7 +112,7 @@ class ScanReconstructor {
   std::vector<float> inner_noise_gain_;
   std::vector<float> outer_noise_gain_;
   std::vector<float> noise_floor_;
-  vision::ImageAnnulus annulus_;
+  vision::ImageNoiseMeter noise_meter_;
   LobeWork inner_;
   LobeWork outer_;
   std::vector<RowMatch> matches_;
