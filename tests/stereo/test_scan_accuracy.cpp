@@ -138,7 +138,7 @@ TEST_CASE("l-room-1lap-real: local scans against the floor plan", "[stereo][accu
 // grey levels of read noise: 21 grey levels of noise at mid-grey, against 3 by default), every
 // other factor as usual. Canny's thresholds rise with the noise each frame measures (no row
 // below what the noise alone reaches at one pixel of a panorama). Measured over every frame:
-// 88.0% of the points within 0.1 m, median relative error 1.97%, 141 points a frame (every
+// 88.1% of the points within 0.1 m, median relative error 1.98%, 141 points a frame (every
 // third frame with scripts/eval-scans: floor contacts 88.7% within 0.1 m and 0.69% median
 // error, against 36.5% and 27.2% when the thresholds ignored the noise, whose edges crowded
 // the columns nearest the robot).
