@@ -159,3 +159,25 @@ TEST_CASE("trajectory grid: an edge seen above the floor stays through a rebuild
   CHECK(cell(grid.image(), edge) == 100);
   CHECK(cell(grid.image(), Eigen::Vector2d(1.325, 0.025)) == 0);
 }
+
+TEST_CASE("trajectory grid: a drop keeps the lower floor it reached through a rebuild", "[grid]") {
+  // A ray crossing the floor's level at 1 m that reached a lower floor 0.3 m farther.
+  TrajectoryGrid grid;
+  const std::vector<Eigen::Isometry2d> trajectory = {pose(0.0, 0.0, 0.0)};
+  Ray drop{0.0, 1.025, 0.5};
+  drop.lower_m = 1.325;
+  REQUIRE(grid.add_scan(0, trajectory[0], std::vector<Ray>{drop}));
+  const auto cell = [](const GridImage &image, double x) {
+    const int column = static_cast<int>(std::floor((x - image.origin_m.x()) / image.resolution_m));
+    const int row = static_cast<int>(std::floor((0.025 - image.origin_m.y()) / image.resolution_m));
+    return image.cells[static_cast<std::size_t>(row * image.width + column)];
+  };
+  const auto over_lower_floor = [&] {
+    int occupied = 0;
+    for (double x = 1.025; x < 1.35; x += 0.05) occupied += cell(grid.image(), x) == 100 ? 1 : 0;
+    return occupied;
+  };
+  CHECK(over_lower_floor() == 7);
+  grid.rebuild(trajectory);
+  CHECK(over_lower_floor() == 7);
+}

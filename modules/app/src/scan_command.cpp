@@ -34,15 +34,18 @@ void print_csv(const stereo::LocalScan &scan) {
   }
 }
 
-// Free floor per panorama column (floor-boundary scans), and where it ended in a drop: "nan"
-// where nothing was seen.
+// Free floor per panorama column (floor-boundary scans), where it ended in a drop and how far
+// the lower floor beyond was seen: "nan" where nothing was seen.
 void print_free_csv(const stereo::LocalScan &scan, const mirror::MirrorConfig &camera) {
-  std::printf("azimuth_deg,free_range_m,drop_range_m\n");
+  std::printf("azimuth_deg,free_range_m,drop_range_m,drop_lower_range_m\n");
+  const auto at = [](const std::vector<float> &ranges_m, std::size_t column) {
+    return column < ranges_m.size() ? static_cast<double>(ranges_m[column])
+                                    : std::numeric_limits<double>::quiet_NaN();
+  };
   for (std::size_t column = 0; column < scan.free_range_m.size(); ++column) {
     const double azimuth_deg = mirror::column_azimuth_rad(camera, static_cast<int>(column)) * kDegPerRad;
-    const double drop_m = column < scan.drop_range_m.size() ? static_cast<double>(scan.drop_range_m[column])
-                                                            : std::numeric_limits<double>::quiet_NaN();
-    std::printf("%.3f,%.4f,%.4f\n", azimuth_deg, static_cast<double>(scan.free_range_m[column]), drop_m);
+    std::printf("%.3f,%.4f,%.4f,%.4f\n", azimuth_deg, at(scan.free_range_m, column),
+                at(scan.drop_range_m, column), at(scan.drop_lower_range_m, column));
   }
 }
 
@@ -79,7 +82,7 @@ void add_scan_command(CLI::App &app) {
   command->add_flag("--quiet", options->quiet, "no summary on stderr");
   command->add_flag("--free", options->free,
                     "print how far the floor was seen to be free per column instead "
-                    "(azimuth_deg,free_range_m; nan where unknown)");
+                    "(azimuth_deg,free_range_m,drop_range_m,drop_lower_range_m; nan where unknown)");
   command->callback([options] {
     const io::Config config = options->config.empty() ? io::Config{} : io::load_config(options->config);
     const cv::Mat image = io::read_camera_image(options->image, config.scan.camera);

@@ -30,14 +30,16 @@ namespace omnislam::app {
       ray.hit_elevated = point.elevated;
     }
   }
-  // A drop (the floor ended before a lower floor) is where the robot cannot go, like a wall's
-  // base, and floor seen there later clears it like one.
+  // A drop (the floor ended before a lower floor) is where the robot cannot go, from where the
+  // ray crossed the floor's level to the lower floor it saw; seen from two viewpoints, floor
+  // seen through it later does not clear it (grid::Ray).
   for (std::size_t column = 0; column < scan.drop_range_m.size() && column < rays.size(); ++column) {
     grid::Ray &ray = rays[column];
     const double drop_m = scan.drop_range_m[column];
     if (std::isfinite(drop_m) && (!std::isfinite(ray.hit_m) || drop_m < ray.hit_m)) {
       ray.hit_m = drop_m;
       ray.hit_elevated = false;
+      ray.lower_m = column < scan.drop_lower_range_m.size() ? scan.drop_lower_range_m[column] : drop_m;
     }
   }
   return rays;

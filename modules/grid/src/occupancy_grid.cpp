@@ -35,7 +35,9 @@ void OccupancyGrid::update(CellState &state, float log_odds) const {
   state.log_odds = std::clamp(state.log_odds + log_odds, min_, max_);
 }
 
-void OccupancyGrid::mark_free(const Eigen::Vector2d &from_m, const Eigen::Vector2d &to_m) {
+template <typename Visit>
+void OccupancyGrid::traverse(const Eigen::Vector2d &from_m, const Eigen::Vector2d &to_m,
+                             Visit &&visit) const {
   // Amanatides-Woo traversal: every cell the segment crosses, in order.
   const Eigen::Vector2d start = from_m / config_.resolution_m, end = to_m / config_.resolution_m;
   Cell cell = cell_of(from_m);
@@ -51,13 +53,26 @@ void OccupancyGrid::mark_free(const Eigen::Vector2d &from_m, const Eigen::Vector
     delta[axis] = step[axis] != 0 ? std::abs(1.0 / direction[axis]) : std::numeric_limits<double>::infinity();
   }
   while (cell != last) {
-    CellState &state = cells_[key(cell)];
-    if (!state.above_floor) update(state, miss_);
+    visit(cell);
     const int axis = next.x() < next.y() ? 0 : 1;
     if (next[axis] > 1.0) break;  // the end lies in this cell after all (rounding)
     cell[axis] += step[axis];
     next[axis] += delta[axis];
   }
+}
+
+void OccupancyGrid::mark_hit(const Cell &cell, const Eigen::Vector2d &origin_m, bool off_floor) {
+  const std::uint64_t cell_key = key(cell);
+  CellState &state = cells_[cell_key];
+  if (off_floor && !state.off_floor) {
+    const auto [first_seen, first] = first_seen_off_.try_emplace(cell_key, origin_m.cast<float>());
+    if (!first && (origin_m.cast<float>() - first_seen->second).norm() >= config_.elevated_baseline_m) {
+      state.off_floor = true;
+      state.log_odds = std::max(state.log_odds, 0.0f);  // the floor seen under it said nothing of it
+      first_seen_off_.erase(first_seen);
+    }
+  }
+  update(state, hit_);
 }
 
 void OccupancyGrid::add_scan(const Eigen::Isometry2d &T_map_base, std::span<const Ray> rays) {
@@ -69,25 +84,33 @@ void OccupancyGrid::add_scan(const Eigen::Isometry2d &T_map_base, std::span<cons
     // Free floor up to the boundary (never past it) or, with none, as far as it was seen.
     double free_m = std::isfinite(ray.free_m) ? ray.free_m : 0.0;
     if (hit) free_m = std::min(free_m, ray.hit_m);
-    if (free_m > 0.0) mark_free(origin, origin + free_m * direction);
-    if (!hit) continue;
-    const std::uint64_t cell = key(cell_of(origin + ray.hit_m * direction));
-    CellState &state = cells_[cell];
-    if (ray.hit_elevated && !state.above_floor) {
-      const auto [first_seen, first] = first_seen_above_.try_emplace(cell, origin.cast<float>());
-      if (!first && (origin.cast<float>() - first_seen->second).norm() >= config_.elevated_baseline_m) {
-        state.above_floor = true;
-        state.log_odds = std::max(state.log_odds, 0.0f);  // the floor seen under it said nothing of it
-        first_seen_above_.erase(first_seen);
-      }
+    if (free_m > 0.0) {
+      traverse(origin, origin + free_m * direction, [&](const Cell &cell) {
+        CellState &state = cells_[key(cell)];
+        if (!state.off_floor) update(state, miss_);
+      });
     }
-    update(state, hit_);
+    if (!hit) continue;
+    const Eigen::Vector2d boundary = origin + ray.hit_m * direction;
+    if (!std::isfinite(ray.lower_m)) {
+      mark_hit(cell_of(boundary), origin, ray.hit_elevated);
+      continue;
+    }
+    // A drop: every cell the ray crossed over the lower floor, the last one included. Where it
+    // crossed the floor's level is certain (one lobe's row) and, seen from two viewpoints, not
+    // cleared by floor seen through it (a ray across a plain sunken floor sees nothing of it);
+    // how far the lower floor reaches rests on the stereo twin (a chance twin under a floor
+    // edge reads as a lower floor too), so those cells are left to the log-odds.
+    const Eigen::Vector2d lower = origin + std::max(ray.lower_m, ray.hit_m) * direction;
+    const Cell crossing = cell_of(boundary), end = cell_of(lower);
+    traverse(boundary, lower, [&](const Cell &cell) { mark_hit(cell, origin, cell == crossing); });
+    if (end != crossing) mark_hit(end, origin, false);
   }
 }
 
 void OccupancyGrid::seed(const GridImage &start) {
   const Eigen::Vector2i low = (start.origin_m / config_.resolution_m).array().round().cast<int>();
-  const bool flagged = start.above_floor.size() == start.cells.size();
+  const bool flagged = start.off_floor.size() == start.cells.size();
   for (int y = 0; y < start.height; ++y) {
     for (int x = 0; x < start.width; ++x) {
       const std::size_t index =
@@ -96,7 +119,7 @@ void OccupancyGrid::seed(const GridImage &start) {
       // Unknown cells too (at even odds): the grid keeps the extent it had.
       CellState &state = cells_[key(low + Cell(x, y))];
       state.log_odds = cell == 100 ? max_ : (cell == 0 ? min_ : 0.0f);
-      state.above_floor = flagged && start.above_floor[index] != 0;
+      state.off_floor = flagged && start.off_floor[index] != 0;
     }
   }
 }
@@ -116,7 +139,7 @@ GridImage OccupancyGrid::image() const {
   image.height = high.y() - low.y() + 1;
   image.origin_m = low.cast<double>() * config_.resolution_m;
   image.cells.assign(static_cast<std::size_t>(image.width) * static_cast<std::size_t>(image.height), -1);
-  image.above_floor.assign(image.cells.size(), 0);
+  image.off_floor.assign(image.cells.size(), 0);
   const float occupied = log_odds_of(config_.occupied_threshold), free = log_odds_of(config_.free_threshold);
   for (const auto &[cell_key, state] : cells_) {
     const int x = static_cast<int>(static_cast<std::int32_t>(cell_key >> 32)) - low.x();
@@ -124,7 +147,7 @@ GridImage OccupancyGrid::image() const {
     const std::size_t index =
         static_cast<std::size_t>(y) * static_cast<std::size_t>(image.width) + static_cast<std::size_t>(x);
     image.cells[index] = state.log_odds >= occupied ? 100 : (state.log_odds <= free ? 0 : -1);
-    image.above_floor[index] = state.above_floor ? 1 : 0;
+    image.off_floor[index] = state.off_floor ? 1 : 0;
   }
   return image;
 }

@@ -30,8 +30,8 @@ bool TrajectoryGrid::add_scan(int trajectory_index, const Eigen::Isometry2d &T_m
   for (const Ray &ray : rays) {
     if (!std::isfinite(ray.hit_m) && !std::isfinite(ray.free_m)) continue;  // nothing seen
     scan.rays.push_back({static_cast<float>(ray.azimuth_rad), static_cast<float>(ray.hit_m),
-                         static_cast<float>(ray.free_m), ray.hit_elevated});
-    for (const double range_m : {ray.hit_m, ray.free_m})
+                         static_cast<float>(ray.free_m), static_cast<float>(ray.lower_m), ray.hit_elevated});
+    for (const double range_m : {ray.hit_m, ray.free_m, ray.lower_m})
       if (std::isfinite(range_m)) scan.reach_m = std::max(scan.reach_m, range_m);
   }
   add_to_grid(scan, T_map_base);
@@ -44,7 +44,7 @@ void TrajectoryGrid::add_to_grid(const KeptScan &scan, const Eigen::Isometry2d &
   std::vector<Ray> rays;
   rays.reserve(scan.rays.size());
   for (const KeptRay &ray : scan.rays)
-    rays.push_back({ray.azimuth_rad, ray.hit_m, ray.free_m, ray.hit_elevated});
+    rays.push_back({ray.azimuth_rad, ray.hit_m, ray.free_m, ray.hit_elevated, ray.lower_m});
   grid_.add_scan(T_map_base, rays);
 }
 

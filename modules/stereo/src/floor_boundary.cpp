@@ -37,7 +37,11 @@ constexpr int kEdgeBlurRows = 3;
 // An edge's outer twin on the floor is sought this far from the floor's row when the frame's
 // sub-pixel placement error is measured (several times any spread seen).
 constexpr float kTwinSearchRows = 2.5f;
+// Drops: a rim seen one degree further round moves by a few percent at the angles the camera
+// sees it; a rim runs on across at least this many columns (a floor edge whose own twin was
+// missed, 30-70 a frame in any room, makes runs of 2-3 columns, rarely more).
 constexpr float kDropAlike = 0.1f;
+constexpr int kDropRimColumns = 4;
 
 int polarity(const vision::EdgeImage &edges, int row, int column) {
   return edges.grad_row.at<std::int16_t>(row, column) >= 0 ? 1 : -1;
@@ -311,9 +315,9 @@ FloorBoundaryFinder::Twin FloorBoundaryFinder::nearest_twin(float outer_row, int
   return twin;
 }
 
-bool FloorBoundaryFinder::below_floor(int column, std::size_t index, float floor_row, double floor_height_m,
-                                      const RowTriangulator &triangulator) const {
-  if (!std::isfinite(floor_row)) return false;
+float FloorBoundaryFinder::below_floor(int column, std::size_t index, float floor_row, double floor_height_m,
+                                       const RowTriangulator &triangulator) const {
+  if (!std::isfinite(floor_row)) return kNaN;
   // The outer edge of the same polarity nearest below the floor's row, more than a floor
   // contact's margin off it and within the twin search: a surface under the floor plane
   // (a step down: 0.18 m lies ~1.2 px below at 1-3 m under a camera 1.05 m up).
@@ -327,9 +331,9 @@ bool FloorBoundaryFinder::below_floor(int column, std::size_t index, float floor
       offset = below;
     }
   }
-  if (twin == nullptr) return false;
+  if (twin == nullptr) return kNaN;
   const auto point = triangulator.triangulate(column, column_inner_[index].row_subpx, twin->row_subpx);
-  return point && point->height_m < floor_height_m;
+  return point && point->height_m < floor_height_m ? static_cast<float>(point->range_m) : kNaN;
 }
 
 const vision::EdgePoint *FloorBoundaryFinder::floor_contact(std::size_t index) const {
@@ -488,31 +492,36 @@ float FloorBoundaryFinder::floor_seen_outer_row(float farthest_floor_row) const 
   return std::isfinite(row) ? row : std::numeric_limits<float>::infinity();
 }
 
-int FloorBoundaryFinder::keep_drops_beside_drops(std::vector<float> &free_range_m,
-                                                 std::vector<float> &drop_range_m) {
-  // A drop's rim runs on across the columns beside it; a twin below the floor by chance (a
-  // floor edge whose own twin was missed: 30-70 a frame in any room) does not. A column's drop
-  // stands when a column beside it saw one at a like range (within 10%: a rim seen one degree
-  // further round moves by a few percent at the angles the camera sees it).
-  const int columns = static_cast<int>(drop_range_m.size());
-  const auto alike = [&](int column, float range_m) {
-    const float other = drop_range_m[static_cast<std::size_t>((column + columns) % columns)];
-    return std::isfinite(other) && std::abs(other - range_m) <= kDropAlike * range_m;
+int FloorBoundaryFinder::keep_drops_along_rims(FloorReach &reach) {
+  // A drop's rim runs on across the columns beside it at like ranges; a twin below the floor
+  // by chance does not (kDropRimColumns).
+  std::vector<float> &drop_m = reach.drop_m;
+  const int columns = static_cast<int>(drop_m.size());
+  const auto at = [&](int column) { return drop_m[static_cast<std::size_t>((column + columns) % columns)]; };
+  const auto alike = [&](int column) {  // column's drop goes on from the one before it
+    const float range_m = at(column), before_m = at(column - 1);
+    return std::isfinite(range_m) && std::isfinite(before_m) &&
+           std::abs(range_m - before_m) <= kDropAlike * range_m;
   };
-  kept_drop_.assign(static_cast<std::size_t>(columns), 0);
-  for (int column = 0; column < columns; ++column) {
-    const float range_m = drop_range_m[static_cast<std::size_t>(column)];
-    kept_drop_[static_cast<std::size_t>(column)] =
-        std::isfinite(range_m) && (alike(column - 1, range_m) || alike(column + 1, range_m));
-  }
+  int first = 0;  // a run's first column: wrapped runs are walked whole
+  while (first < columns && alike(first)) ++first;
+  if (first == columns) first = 0;
   int kept = 0;
-  for (std::size_t c = 0; c < drop_range_m.size(); ++c) {
-    if (!kept_drop_[c]) {
-      drop_range_m[c] = kNaN;
-      continue;
+  for (int offset = 0; offset < columns;) {
+    const int start = first + offset;
+    int length = std::isfinite(at(start)) ? 1 : 0;
+    while (length > 0 && length < columns && alike(start + length)) ++length;
+    for (int k = 0; k < std::max(length, 1); ++k) {
+      const auto c = static_cast<std::size_t>((start + k) % columns);
+      if (length >= kDropRimColumns) {
+        ++kept;
+        if (std::isfinite(reach.free_m[c])) reach.free_m[c] = std::min(reach.free_m[c], drop_floor_m_[c]);
+      } else {
+        drop_m[c] = kNaN;
+        reach.lower_m[c] = kNaN;
+      }
     }
-    ++kept;
-    if (std::isfinite(free_range_m[c])) free_range_m[c] = std::min(free_range_m[c], drop_floor_m_[c]);
+    offset += std::max(length, 1);
   }
   return kept;
 }
@@ -524,8 +533,7 @@ BoundaryStats FloorBoundaryFinder::find(const FloorGeometry &geometry, const cv:
                                         const vision::ColumnEdges &outer_candidates,
                                         const DisparityLimits &limits, const RowTriangulator &triangulator,
                                         const vision::EdgeSelectionConfig &window,
-                                        std::vector<BoundaryPoint> &points, std::vector<float> &free_range_m,
-                                        std::vector<float> &drop_range_m) {
+                                        std::vector<BoundaryPoint> &points, FloorReach &reach) {
   geometry_ = &geometry;
   prepare(inner_texture, outer_texture);
   measure_twin_spread(inner_edges, outer_edges, inner_candidates, outer_candidates);
@@ -534,9 +542,9 @@ BoundaryStats FloorBoundaryFinder::find(const FloorGeometry &geometry, const cv:
   stats.twin_spread_px = twin_spread_px_;
   const double floor_height_m = -geometry_->camera_height_m();
   points.clear();
-  free_range_m.assign(static_cast<std::size_t>(inner_candidates.columns()), kNaN);
-  drop_range_m.assign(static_cast<std::size_t>(inner_candidates.columns()), kNaN);
-  drop_floor_m_.assign(static_cast<std::size_t>(inner_candidates.columns()), kNaN);
+  const auto columns = static_cast<std::size_t>(inner_candidates.columns());
+  for (std::vector<float> *range_m : {&reach.free_m, &reach.drop_m, &reach.lower_m, &drop_floor_m_})
+    range_m->assign(columns, kNaN);
   for (int column = 0; column < inner_candidates.columns(); ++column) {
     const auto outer_edges_here = outer_candidates.column(column);
     float free_end_m = kNaN;          // an edge off the floor that nothing explains
@@ -544,6 +552,7 @@ BoundaryStats FloorBoundaryFinder::find(const FloorGeometry &geometry, const cv:
     float boundary_m = kNaN;
     bool floor_reaches_boundary = false;  // a floor contact: the floor was seen up to it
     float drop_m = kNaN;                  // a lower floor seen beyond: the floor ended before this
+    float lower_m = kNaN;                 // where in plan that lower floor was seen
     float floor_before_drop_m = kNaN;     // how far the floor was seen before the drop
     const auto inner_edges_here = inner_candidates.column(column);
     // 1. Is there an outer edge of the same polarity where the floor puts each edge? (Asked
@@ -581,9 +590,9 @@ BoundaryStats FloorBoundaryFinder::find(const FloorGeometry &geometry, const cv:
       //    step down, whose rim this column's ray crossed before reaching it, at the floor
       //    level's range. The floor ended nearer. (The search itself goes on as before: a
       //    drop bounds the free floor, it is not a scan point.)
-      if (contact == nullptr && match == nullptr && !std::isfinite(drop_m) &&
-          below_floor(column, index, floor_row, floor_height_m, triangulator)) {
-        drop_m = static_cast<float>(geometry_->floor_range_at(edge.row_subpx));
+      if (contact == nullptr && match == nullptr && !std::isfinite(drop_m)) {
+        lower_m = below_floor(column, index, floor_row, floor_height_m, triangulator);
+        if (std::isfinite(lower_m)) drop_m = static_cast<float>(geometry_->floor_range_at(edge.row_subpx));
         floor_before_drop_m = std::isfinite(farthest_floor_row)
                                   ? static_cast<float>(geometry_->floor_range_at(farthest_floor_row))
                                   : 0.0f;
@@ -698,7 +707,7 @@ BoundaryStats FloorBoundaryFinder::find(const FloorGeometry &geometry, const cv:
     // table the floor's texture shows it, but the face of a box, a sofa or a low platform
     // hides it (with its base in the blind zone or its front edge without contrast, the edge
     // matched is its back edge), so the floor is free only as far as it was seen, short of it.
-    float &free_m = free_range_m[static_cast<std::size_t>(column)];
+    float &free_m = reach.free_m[static_cast<std::size_t>(column)];
     if (floor_reaches_boundary) {
       free_m = std::isfinite(free_end_m) ? std::min(free_end_m, boundary_m) : boundary_m;
     } else {
@@ -709,11 +718,12 @@ BoundaryStats FloorBoundaryFinder::find(const FloorGeometry &geometry, const cv:
       if (std::isfinite(boundary_m) && std::isfinite(free_m)) free_m = std::min(free_m, boundary_m);
     }
     if (std::isfinite(drop_m) && !(boundary_m <= drop_m)) {  // a drop before any boundary
-      drop_range_m[static_cast<std::size_t>(column)] = drop_m;
+      reach.drop_m[static_cast<std::size_t>(column)] = drop_m;
+      reach.lower_m[static_cast<std::size_t>(column)] = lower_m;
       drop_floor_m_[static_cast<std::size_t>(column)] = floor_before_drop_m;
     }
   }
-  stats.drops = keep_drops_beside_drops(free_range_m, drop_range_m);
+  stats.drops = keep_drops_along_rims(reach);
   return stats;
 }
 

@@ -169,10 +169,9 @@ void ScanReconstructor::match() {
   matches_.clear();
   match_stats_ = {};
   if (floor_boundary()) {
-    boundary_stats_ =
-        boundary_finder_.find(floor_geometry_, inner_.texture, outer_.texture, inner_.edges, outer_.edges,
-                              inner_.candidates, outer_.candidates, limits_, triangulator_, selection_,
-                              boundary_points_, free_range_m_, drop_range_m_);
+    boundary_stats_ = boundary_finder_.find(floor_geometry_, inner_.texture, outer_.texture, inner_.edges,
+                                            outer_.edges, inner_.candidates, outer_.candidates, limits_,
+                                            triangulator_, selection_, boundary_points_, reach_);
     return;
   }
   for (int column = 0; column < inner_.candidates.columns(); ++column) {
@@ -258,8 +257,9 @@ void ScanReconstructor::build_boundary_scan(LocalScan &scan) {
   if (config_.stereo.one_point_per_degree)
     scan.stats.filtered_out = keep_nearest_per_degree(scan.points, filtered_);
   scan.stats.points = static_cast<int>(scan.points.size());
-  scan.free_range_m = free_range_m_;
-  scan.drop_range_m = drop_range_m_;
+  scan.free_range_m = reach_.free_m;
+  scan.drop_range_m = reach_.drop_m;
+  scan.drop_lower_range_m = reach_.lower_m;
   scan.stats.drops = boundary_stats_.drops;
 }
 
@@ -268,6 +268,7 @@ void ScanReconstructor::build_scan(const std::vector<RowMatch> &matches, LocalSc
   scan.points.clear();
   scan.free_range_m.clear();
   scan.drop_range_m.clear();
+  scan.drop_lower_range_m.clear();
   for (const RowMatch &match : matches) {
     const auto point = triangulator_.triangulate(match.column, match.inner_row, match.outer_row);
     if (!point) {

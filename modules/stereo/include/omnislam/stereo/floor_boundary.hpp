@@ -81,22 +81,31 @@ struct BoundaryStats {
 };
 
 /// Scratch images between frames; not thread-safe (one per thread).
+/// What each panorama column showed of the floor (NaN where nothing).
+struct FloorReach {
+  /// How far the floor was seen to be free.
+  std::vector<float> free_m;
+  /// Where a lower floor seen beyond showed the floor ending before any boundary (a step
+  /// down): the floor level's range of the ray that reached it (the rim is nearer).
+  std::vector<float> drop_m;
+  /// The range in plan of the lower floor's point that ray reached: from drop_m to here the
+  /// ray ran below the floor's level, over the lower floor.
+  std::vector<float> lower_m;
+};
+
 class FloorBoundaryFinder {
  public:
   explicit FloorBoundaryFinder(const FloorBoundaryConfig &config = {});
 
   /// Finds the boundary of every column. `inner`/`outer` textures are CV_32FC1 in [0, 1];
-  /// the candidates are every horizontal edge of each column, nearest first.
-  /// `free_range_m` gets, per column, how far the floor was seen to be free (NaN: unknown);
-  /// `drop_range_m` where a lower floor seen beyond showed the floor ending before any
-  /// boundary (the floor level's range of the ray that reached it; NaN: none).
+  /// the candidates are every horizontal edge of each column, nearest first; `reach` gets what
+  /// each column showed of the floor (FloorReach).
   BoundaryStats find(const FloorGeometry &geometry, const cv::Mat &inner_texture,
                      const cv::Mat &outer_texture, const vision::EdgeImage &inner_edges,
                      const vision::EdgeImage &outer_edges, const vision::ColumnEdges &inner_candidates,
                      const vision::ColumnEdges &outer_candidates, const DisparityLimits &limits,
                      const RowTriangulator &triangulator, const vision::EdgeSelectionConfig &window,
-                     std::vector<BoundaryPoint> &points, std::vector<float> &free_range_m,
-                     std::vector<float> &drop_range_m);
+                     std::vector<BoundaryPoint> &points, FloorReach &reach);
 
  private:
   /// Smoothed column-major textures, the lobes' gain, the floor residuals, the noise scale.
@@ -118,14 +127,14 @@ class FloorBoundaryFinder {
   /// from it (nullptr and infinity when the column has none).
   /// Whether edge `index` of the current column is a surface below the floor: its nearest
   /// same-polarity outer edge below the floor's row, beyond the contact margin, triangulates
-  /// under the floor plane.
-  [[nodiscard]] bool below_floor(int column, std::size_t index, float floor_row, double floor_height_m,
-                                 const RowTriangulator &triangulator) const;
-  /// Keeps the drops a neighbouring column confirms (NaN for the others) and stops their
-  /// columns' free floor where it was seen before the drop; returns how many were kept.
-  int keep_drops_beside_drops(std::vector<float> &free_range_m, std::vector<float> &drop_range_m);
-  std::vector<float> drop_floor_m_;      ///< per column, how far the floor was seen before its drop
-  std::vector<std::uint8_t> kept_drop_;  ///< per column, whether its drop has a like one beside it
+  /// under the floor plane. Returns that point's range in plan, NaN when it is not.
+  [[nodiscard]] float below_floor(int column, std::size_t index, float floor_row, double floor_height_m,
+                                  const RowTriangulator &triangulator) const;
+  /// Keeps the drops along a rim (a run of at least kDropRimColumns columns with like ranges;
+  /// NaN for the others) and stops their columns' free floor where it was seen before the
+  /// drop; returns how many were kept.
+  int keep_drops_along_rims(FloorReach &reach);
+  std::vector<float> drop_floor_m_;  ///< per column, how far the floor was seen before its drop
   struct Twin {
     const vision::EdgePoint *edge = nullptr;
     float offset = std::numeric_limits<float>::infinity();

@@ -88,6 +88,10 @@ struct LocalScan {
   /// it crossed the floor's level (the step's rim is nearer). NaN where none was seen; empty
   /// for the nearest-edge method. Not scan points: what lies there depends on the viewpoint.
   std::vector<float> drop_range_m;
+  /// Per panorama column with a drop, the range in plan of the lower floor's point the ray
+  /// reached (from drop_range_m to here it ran below the floor's level: over the lower floor,
+  /// not where the robot can go); NaN elsewhere.
+  std::vector<float> drop_lower_range_m;
   ScanStats stats;
 };
 

@@ -119,8 +119,7 @@ class ScanReconstructor {
   MatchStats match_stats_;
   FloorBoundaryFinder boundary_finder_;
   std::vector<BoundaryPoint> boundary_points_;
-  std::vector<float> free_range_m_;
-  std::vector<float> drop_range_m_;
+  FloorReach reach_;
   BoundaryStats boundary_stats_;
   std::vector<ScanPoint> filtered_;
 };
