@@ -243,6 +243,16 @@ def home_step_room() -> Room:
     return room
 
 
+def home_deep_room() -> Room:
+    """A held-out scene (not bundled): the sunken area of `home_step_room` 0.55 m deep (three
+    steps' worth, as a loading bay's or a stairwell's edge without its railing): its lower floor
+    lies several pixels below the floor's row in the outer lobe, not one."""
+    room = home_step_room()
+    room.name = "home-deep"
+    room.pits = [Pit("sunken area", (2.4, 1.8), (3.9, 2.7), 0.55)]
+    return room
+
+
 def _legged_table(name: str, x0: float, y0: float, x1: float, y1: float, height: float) -> list:
     top = Box(f"{name} top", (x0, y0, height - 0.03), (x1, y1, height), TABLE_TOP)
     legs = [Box(f"{name} leg {k + 1}", (lx, ly, 0.0), (lx + 0.05, ly + 0.05, height - 0.03), TABLE_FOOT)
