@@ -57,6 +57,35 @@ TEST_CASE("floor geometry: a vertical surface on the floor is seen at its base's
   CHECK(checked > 40);
 }
 
+TEST_CASE(
+    "floor geometry: a floor one camera height down is seen below the floor's row, a lower floor between",
+    "[stereo][floor]") {
+  const MirrorModel model;
+  const double height_m = 1.05;
+  const FloorGeometry geometry(model, height_m);
+  int checked = 0;
+  for (int row = 40; row < 220; row += 20) {
+    const auto inner_row = static_cast<float>(row);
+    const float floor_outer = geometry.floor_outer_row_at(inner_row);
+    const float lowest_outer = geometry.lowest_outer_row_at(inner_row);
+    if (!std::isfinite(floor_outer) || !std::isfinite(lowest_outer)) continue;
+    // The lowest floor's pair triangulates one camera height under the floor.
+    const auto lowest = model.triangulate_rows(row, lowest_outer);
+    REQUIRE(lowest);
+    CHECK(lowest->height_m == Approx(-2.0 * height_m).epsilon(1e-3));
+    // A step 0.18 m down along the same inner ray lies between the floor's row and it.
+    const auto ray = model.back_project(Lobe::kInner, model.radius_px_of_row(Lobe::kInner, row));
+    const double range_m =
+        ray.origin.range_m + (ray.origin.height_m + height_m + 0.18) * std::tan(ray.theta_rad);
+    const auto step_outer = model.project_row(Lobe::kOuter, {range_m, -height_m - 0.18});
+    REQUIRE(step_outer);
+    CHECK(*step_outer < floor_outer);
+    CHECK(*step_outer > lowest_outer);
+    ++checked;
+  }
+  CHECK(checked >= 6);
+}
+
 TEST_CASE("floor boundary on the convention image: one point per column at most, free ranges",
           "[stereo][floor]") {
   const cv::Mat image = cv::imread(OMNISLAM_CONVENTION_IMAGE, cv::IMREAD_GRAYSCALE);

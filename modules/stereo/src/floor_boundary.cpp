@@ -319,10 +319,12 @@ float FloorBoundaryFinder::below_floor(int column, std::size_t index, float floo
                                        const RowTriangulator &triangulator) const {
   if (!std::isfinite(floor_row)) return kNaN;
   // The outer edge of the same polarity nearest below the floor's row, more than a floor
-  // contact's margin off it and within the twin search: a surface under the floor plane
-  // (a step down: 0.18 m lies ~1.2 px below at 1-3 m under a camera 1.05 m up).
+  // contact's margin off it, and no lower than a floor one camera height down would put it:
+  // a surface under the floor plane (under a camera 1.05 m up, at 1-3 m, a step 0.18 m down
+  // lies ~1.2 px below the floor's row, a sunken area 0.55 m down ~3 px, a floor 1.05 m
+  // down ~5 px; a deeper drop, a stairwell, shows its first steps within that).
   const vision::EdgePoint *twin = nullptr;
-  float offset = kTwinSearchRows;
+  float offset = floor_row - geometry_->lowest_outer_row_at(column_inner_[index].row_subpx);
   for (std::size_t k = 0; k < column_outer_.size(); ++k) {
     const float below = floor_row - column_outer_[k].row_subpx;
     if (outer_sign_[k] == inner_sign_[index] && below > static_cast<float>(config_.contact_margin_px) &&

@@ -24,6 +24,7 @@ FloorGeometry::FloorGeometry(const mirror::MirrorModel &model, double camera_hei
   const auto rows = static_cast<std::size_t>(rows_);
   floor_range_m_.assign(rows, kNaN);
   floor_outer_row_.assign(rows, kNaN);
+  lowest_outer_row_.assign(rows, kNaN);
   vertical_outer_row_.assign(rows * rows, kNaN);
   std::vector<mirror::MeridianRay> rays;
   for (int row = 0; row < rows_; ++row) {
@@ -32,6 +33,11 @@ FloorGeometry::FloorGeometry(const mirror::MirrorModel &model, double camera_hei
     if (!std::isfinite(range_m)) continue;
     floor_range_m_[index(row)] = static_cast<float>(range_m);
     floor_outer_row_[index(row)] = row_or_nan(model.project_row(Lobe::kOuter, {range_m, -camera_height_m}));
+    const mirror::MeridianRay &ray = rays.back();
+    const double lowest_m = -2.0 * camera_height_m;
+    const double lowest_range_m =
+        ray.origin.range_m + (ray.origin.height_m - lowest_m) * std::tan(ray.theta_rad);
+    lowest_outer_row_[index(row)] = row_or_nan(model.project_row(Lobe::kOuter, {lowest_range_m, lowest_m}));
   }
   for (int base = 0; base < rows_; ++base) {
     const double wall_m = floor_range_m_[index(base)];
@@ -52,6 +58,14 @@ float FloorGeometry::floor_outer_row_at(float inner_row) const {
   const float fraction = inner_row - static_cast<float>(below);
   return floor_outer_row_[index(below)] +
          fraction * (floor_outer_row_[index(below + 1)] - floor_outer_row_[index(below)]);
+}
+
+float FloorGeometry::lowest_outer_row_at(float inner_row) const {
+  if (!(inner_row >= 0.0f) || inner_row > static_cast<float>(rows_ - 1)) return kNaN;
+  const int below = std::min(rows_ - 2, static_cast<int>(inner_row));
+  const float fraction = inner_row - static_cast<float>(below);
+  return lowest_outer_row_[index(below)] +
+         fraction * (lowest_outer_row_[index(below + 1)] - lowest_outer_row_[index(below)]);
 }
 
 double FloorGeometry::floor_range_at(double inner_row) const {

@@ -16,6 +16,9 @@
 /// - Vertical surface: a surface standing on the floor at the floor range of inner row e
 ///   (a wall whose base is seen at e) is seen by inner row i < e at some height; the
 ///   outer lobe sees that point at vertical_outer_row(i, e).
+/// - Below the floor: the inner ray of row i, past the floor's level, meets a lower floor
+///   at some depth; the outer lobe sees it between floor_outer_row(i) (no depth) and, for a
+///   lower floor at most a camera height down, lowest_outer_row(i).
 /// Rows are continuous panorama rows (mirror.md sec. 0); NaN marks a point a lobe does not
 /// see (or a ray that never meets the floor).
 
@@ -35,6 +38,10 @@ class FloorGeometry {
   [[nodiscard]] float floor_outer_row(int inner_row) const { return floor_outer_row_[index(inner_row)]; }
   /// The same at a fractional inner row (linear between rows; NaN if either is unseen).
   [[nodiscard]] float floor_outer_row_at(float inner_row) const;
+  /// Outer row of the inner ray of row i where it meets a floor one camera height below the
+  /// floor (a lower floor at most that deep is seen between it and floor_outer_row), at a
+  /// fractional row (linear between rows; NaN if either is unseen).
+  [[nodiscard]] float lowest_outer_row_at(float inner_row) const;
   /// Outer row of the point of inner row `row` on the vertical surface whose base is the
   /// floor point of inner row `base_row` (row < base_row; NaN otherwise or when unseen).
   [[nodiscard]] float vertical_outer_row(int row, int base_row) const {
@@ -72,6 +79,7 @@ class FloorGeometry {
   float outer_radius_offset_px_ = 0.0f;
   std::vector<float> floor_range_m_;
   std::vector<float> floor_outer_row_;
+  std::vector<float> lowest_outer_row_;
   std::vector<float> vertical_outer_row_;  ///< [base_row][row]
 };
 
