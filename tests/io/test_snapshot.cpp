@@ -238,7 +238,7 @@ omnislam::grid::GridImage example_grid() {
   g.origin_m = {-1.25, 0.4};
   for (int i = 0; i < g.width * g.height; ++i) g.cells.push_back(i % 3 == 0 ? -1 : (i % 3 == 1 ? 0 : 100));
   for (int i = 0; i < g.width * g.height; ++i)
-    g.off_floor.push_back(i % 6 == 2 ? 1 : 0);  // some occupied cells
+    g.above_floor.push_back(i % 6 == 2 ? 1 : 0);  // some occupied cells
   return g;
 }
 
@@ -260,14 +260,14 @@ TEST_CASE(
   CHECK(read.grid->resolution_m == 0.05);
   CHECK(read.grid->origin_m == Eigen::Vector2d(-1.25, 0.4));
   CHECK(read.grid->cells == written.grid->cells);
-  CHECK(read.grid->off_floor == written.grid->off_floor);
+  CHECK(read.grid->above_floor == written.grid->above_floor);
   CHECK(read.points.size() == 50);
   // A grid without flags (read from a map file) is written as none above the floor.
   Snapshot unflagged = written;
-  unflagged.grid->off_floor.clear();
+  unflagged.grid->above_floor.clear();
   const Snapshot zeros =
       omnislam::io::decode_snapshot(omnislam::io::encode_snapshot(unflagged), "zeros.snap");
-  CHECK(zeros.grid->off_floor == std::vector<std::uint8_t>(21, 0));
+  CHECK(zeros.grid->above_floor == std::vector<std::uint8_t>(21, 0));
 
   // Version 4: version 5 without the flags (the 21 bytes before has_graph), still read.
   std::vector<std::uint8_t> v4 = v5;
@@ -278,7 +278,7 @@ TEST_CASE(
   CHECK(four.version == 4);
   REQUIRE(four.grid);
   CHECK(four.grid->cells == written.grid->cells);
-  CHECK(four.grid->off_floor.empty());
+  CHECK(four.grid->above_floor.empty());
 
   // Version 3: version 4 without the graph section (has_graph 0: 8 bytes), still read.
   std::vector<std::uint8_t> v3 = v4;

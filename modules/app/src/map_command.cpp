@@ -45,10 +45,10 @@ void print_info(const std::filesystem::path &file) {
               ", dropped %" PRIu64 "\n",
               n.frames, n.integrated, n.not_integrated, n.skipped, n.dropped);
   if (s.grid) {
-    std::printf("occupancy grid: %d x %d cells at %.3f m, origin (%.3f, %.3f) m, %zu seen above the floor\n",
-                s.grid->width, s.grid->height, s.grid->resolution_m, s.grid->origin_m.x(),
-                s.grid->origin_m.y(),
-                static_cast<std::size_t>(std::count(s.grid->off_floor.begin(), s.grid->off_floor.end(), 1)));
+    std::printf(
+        "occupancy grid: %d x %d cells at %.3f m, origin (%.3f, %.3f) m, %zu seen above the floor\n",
+        s.grid->width, s.grid->height, s.grid->resolution_m, s.grid->origin_m.x(), s.grid->origin_m.y(),
+        static_cast<std::size_t>(std::count(s.grid->above_floor.begin(), s.grid->above_floor.end(), 1)));
   } else {
     std::printf("occupancy grid: none\n");
   }

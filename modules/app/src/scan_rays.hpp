@@ -31,8 +31,8 @@ namespace omnislam::app {
     }
   }
   // A drop (the floor ended before a lower floor) is where the robot cannot go, from where the
-  // ray crossed the floor's level to the lower floor it saw; seen from two viewpoints, floor
-  // seen through it later does not clear it (grid::Ray).
+  // ray crossed the floor's level to the lower floor it saw (grid::Ray); floor seen there later
+  // clears it like a wall's base.
   for (std::size_t column = 0; column < scan.drop_range_m.size() && column < rays.size(); ++column) {
     grid::Ray &ray = rays[column];
     const double drop_m = scan.drop_range_m[column];

@@ -61,15 +61,15 @@ void OccupancyGrid::traverse(const Eigen::Vector2d &from_m, const Eigen::Vector2
   }
 }
 
-void OccupancyGrid::mark_hit(const Cell &cell, const Eigen::Vector2d &origin_m, bool off_floor) {
+void OccupancyGrid::mark_hit(const Cell &cell, const Eigen::Vector2d &origin_m, bool elevated) {
   const std::uint64_t cell_key = key(cell);
   CellState &state = cells_[cell_key];
-  if (off_floor && !state.off_floor) {
-    const auto [first_seen, first] = first_seen_off_.try_emplace(cell_key, origin_m.cast<float>());
+  if (elevated && !state.above_floor) {
+    const auto [first_seen, first] = first_seen_above_.try_emplace(cell_key, origin_m.cast<float>());
     if (!first && (origin_m.cast<float>() - first_seen->second).norm() >= config_.elevated_baseline_m) {
-      state.off_floor = true;
+      state.above_floor = true;
       state.log_odds = std::max(state.log_odds, 0.0f);  // the floor seen under it said nothing of it
-      first_seen_off_.erase(first_seen);
+      first_seen_above_.erase(first_seen);
     }
   }
   update(state, hit_);
@@ -87,7 +87,7 @@ void OccupancyGrid::add_scan(const Eigen::Isometry2d &T_map_base, std::span<cons
     if (free_m > 0.0) {
       traverse(origin, origin + free_m * direction, [&](const Cell &cell) {
         CellState &state = cells_[key(cell)];
-        if (!state.off_floor) update(state, miss_);
+        if (!state.above_floor) update(state, miss_);
       });
     }
     if (!hit) continue;
@@ -96,21 +96,18 @@ void OccupancyGrid::add_scan(const Eigen::Isometry2d &T_map_base, std::span<cons
       mark_hit(cell_of(boundary), origin, ray.hit_elevated);
       continue;
     }
-    // A drop: every cell the ray crossed over the lower floor, the last one included. Where it
-    // crossed the floor's level is certain (one lobe's row) and, seen from two viewpoints, not
-    // cleared by floor seen through it (a ray across a plain sunken floor sees nothing of it);
-    // how far the lower floor reaches rests on the stereo twin (a chance twin under a floor
-    // edge reads as a lower floor too), so those cells are left to the log-odds.
+    // A drop: every cell the ray crossed over the lower floor, the last one included. Like a
+    // wall's base, floor seen through them later clears them: a chance twin under a floor edge
+    // reads as a lower floor too, and a real one is seen again from every side.
     const Eigen::Vector2d lower = origin + std::max(ray.lower_m, ray.hit_m) * direction;
-    const Cell crossing = cell_of(boundary), end = cell_of(lower);
-    traverse(boundary, lower, [&](const Cell &cell) { mark_hit(cell, origin, cell == crossing); });
-    if (end != crossing) mark_hit(end, origin, false);
+    traverse(boundary, lower, [&](const Cell &cell) { mark_hit(cell, origin, false); });
+    mark_hit(cell_of(lower), origin, false);
   }
 }
 
 void OccupancyGrid::seed(const GridImage &start) {
   const Eigen::Vector2i low = (start.origin_m / config_.resolution_m).array().round().cast<int>();
-  const bool flagged = start.off_floor.size() == start.cells.size();
+  const bool flagged = start.above_floor.size() == start.cells.size();
   for (int y = 0; y < start.height; ++y) {
     for (int x = 0; x < start.width; ++x) {
       const std::size_t index =
@@ -119,7 +116,7 @@ void OccupancyGrid::seed(const GridImage &start) {
       // Unknown cells too (at even odds): the grid keeps the extent it had.
       CellState &state = cells_[key(low + Cell(x, y))];
       state.log_odds = cell == 100 ? max_ : (cell == 0 ? min_ : 0.0f);
-      state.off_floor = flagged && start.off_floor[index] != 0;
+      state.above_floor = flagged && start.above_floor[index] != 0;
     }
   }
 }
@@ -139,7 +136,7 @@ GridImage OccupancyGrid::image() const {
   image.height = high.y() - low.y() + 1;
   image.origin_m = low.cast<double>() * config_.resolution_m;
   image.cells.assign(static_cast<std::size_t>(image.width) * static_cast<std::size_t>(image.height), -1);
-  image.off_floor.assign(image.cells.size(), 0);
+  image.above_floor.assign(image.cells.size(), 0);
   const float occupied = log_odds_of(config_.occupied_threshold), free = log_odds_of(config_.free_threshold);
   for (const auto &[cell_key, state] : cells_) {
     const int x = static_cast<int>(static_cast<std::int32_t>(cell_key >> 32)) - low.x();
@@ -147,7 +144,7 @@ GridImage OccupancyGrid::image() const {
     const std::size_t index =
         static_cast<std::size_t>(y) * static_cast<std::size_t>(image.width) + static_cast<std::size_t>(x);
     image.cells[index] = state.log_odds >= occupied ? 100 : (state.log_odds <= free ? 0 : -1);
-    image.off_floor[index] = state.off_floor ? 1 : 0;
+    image.above_floor[index] = state.above_floor ? 1 : 0;
   }
   return image;
 }

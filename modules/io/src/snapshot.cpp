@@ -119,7 +119,7 @@ void fsync_directory(const std::filesystem::path &dir) {
 // 5, a byte per cell marking what stood above the floor; followed by `trailing` more bytes at
 // least (version 4's graph section) or, with 0, nothing.
 std::optional<grid::GridImage> decode_grid(ByteReader &in, const std::string &name, std::size_t trailing,
-                                           bool with_off_floor) {
+                                           bool with_above_floor) {
   const std::uint64_t has_grid = in.u64();
   if (has_grid > 1) throw SnapshotError(name + ": has_grid is " + std::to_string(has_grid));
   if (has_grid == 0) return std::nullopt;
@@ -135,7 +135,7 @@ std::optional<grid::GridImage> decode_grid(ByteReader &in, const std::string &na
                         std::to_string(g.height) + " cells at " + std::to_string(g.resolution_m) + " m");
   }
   const std::uint64_t cells = static_cast<std::uint64_t>(g.width) * static_cast<std::uint64_t>(g.height);
-  const std::uint64_t bytes = with_off_floor ? 2 * cells : cells;
+  const std::uint64_t bytes = with_above_floor ? 2 * cells : cells;
   const std::uint64_t available = in.remaining() >= trailing ? in.remaining() - trailing : 0;
   if (trailing == 0 ? available != bytes : available < bytes) {
     throw SnapshotError(name + ": the occupancy grid announces " + std::to_string(cells) + " cells (" +
@@ -150,15 +150,15 @@ std::optional<grid::GridImage> decode_grid(ByteReader &in, const std::string &na
                           std::to_string(g.cells[i]) + " (not -1, 0 or 100)");
     }
   }
-  if (!with_off_floor) return g;
-  g.off_floor.resize(cells);
+  if (!with_above_floor) return g;
+  g.above_floor.resize(cells);
   for (std::uint64_t i = 0; i < cells; ++i) {
     const std::int8_t flag = in.i8();
     if (flag != 0 && flag != 1) {
       throw SnapshotError(name + ": occupancy grid cell " + std::to_string(i) + " has above-floor flag " +
                           std::to_string(flag) + " (not 0 or 1)");
     }
-    g.off_floor[i] = static_cast<std::uint8_t>(flag);
+    g.above_floor[i] = static_cast<std::uint8_t>(flag);
   }
   return g;
 }
@@ -335,8 +335,8 @@ std::vector<std::uint8_t> encode_snapshot(const Snapshot &snapshot) {
     payload.f64(g.origin_m.x());
     payload.f64(g.origin_m.y());
     for (const std::int8_t cell : g.cells) payload.i8(cell);
-    const bool flagged = g.off_floor.size() == g.cells.size();
-    for (std::size_t i = 0; i < g.cells.size(); ++i) payload.i8(flagged && g.off_floor[i] != 0 ? 1 : 0);
+    const bool flagged = g.above_floor.size() == g.cells.size();
+    for (std::size_t i = 0; i < g.cells.size(); ++i) payload.i8(flagged && g.above_floor[i] != 0 ? 1 : 0);
   }
   encode_graph(payload, snapshot.graph);
 

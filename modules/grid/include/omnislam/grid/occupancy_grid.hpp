@@ -13,14 +13,13 @@
 /// occupied, in log-odds (the usual inverse sensor model). The grid grows with what is seen.
 ///
 /// The free floor is seen at floor level, under (or over) whatever stands above it: a cell
-/// where something off the floor's level was seen (a table's or a desk's edge, a low box's top;
-/// a lower floor past a step down) is not cleared by floor seen under, through or beyond it,
-/// before or after (an obstacle to a robot as tall as the camera, or a hole it would fall
-/// into; the rays under a desk see its floor, not its top, and a ray across a plain sunken
-/// floor sees nothing of it), once two viewpoints at least `elevated_baseline_m` apart have
-/// seen it there: a thing in the room stays where it is when the robot moves, a wrong match
-/// that moves with the robot (a reflection, a texture read as a step) does not. Other cells,
-/// where the floor itself ended (a wall's base, a leg, a person's feet), are cleared by floor
+/// where something above the floor was seen (a table's or a desk's edge, a low box's top) is
+/// not cleared by floor seen under or beyond it, before or after (it is an obstacle to a
+/// robot as tall as the camera; the rays under a desk see its floor, not its top), once two
+/// viewpoints at least `elevated_baseline_m` apart have seen it there: a thing in the room
+/// stays where it is when the robot moves, a wrong match that moves with the robot (a
+/// reflection, a texture read as a step) does not. Other cells, where the floor itself ended
+/// (a wall's base, a leg, a person's feet, a step down's lower floor), are cleared by floor
 /// seen through them later.
 
 namespace omnislam::grid {
@@ -64,11 +63,10 @@ struct GridImage {
   double resolution_m = 0.05;
   Eigen::Vector2d origin_m = Eigen::Vector2d::Zero();
   std::vector<std::int8_t> cells;
-  /// Per cell in the layout of `cells`, 1 where something off the floor's level (above it, or
-  /// a lower floor below it) was seen from two viewpoints (floor seen under or through it no
-  /// longer clears it), else 0; empty when not known (a grid read from a map file). Not part
-  /// of nav_msgs/OccupancyGrid: kept for resuming.
-  std::vector<std::uint8_t> off_floor;
+  /// Per cell in the layout of `cells`, 1 where something above the floor was seen from two
+  /// viewpoints (floor seen under it no longer clears it), else 0; empty when not known (a
+  /// grid read from a map file). Not part of nav_msgs/OccupancyGrid: kept for resuming.
+  std::vector<std::uint8_t> above_floor;
 };
 
 class OccupancyGrid {
@@ -93,27 +91,27 @@ class OccupancyGrid {
  private:
   using Cell = Eigen::Vector2i;
   [[nodiscard]] Cell cell_of(const Eigen::Vector2d &point_m) const;
-  /// A cell's log-odds, and whether something off the floor's level was seen there from two
-  /// viewpoints elevated_baseline_m apart (then floor seen under or through it no longer counts).
+  /// A cell's log-odds, and whether something above the floor was seen there from two
+  /// viewpoints elevated_baseline_m apart (then floor seen under it no longer counts).
   struct CellState {
     float log_odds = 0.0f;
-    bool off_floor = false;
+    bool above_floor = false;
   };
   void update(CellState &state, float log_odds) const;
   /// Calls visit(cell) for the cells from `from_m` towards `to_m`, each once, in order,
   /// excluding the cell of `to_m`.
   template <typename Visit>
   void traverse(const Eigen::Vector2d &from_m, const Eigen::Vector2d &to_m, Visit &&visit) const;
-  /// A boundary in `cell` seen from `origin_m`; `off_floor`: above or below the floor's level.
-  void mark_hit(const Cell &cell, const Eigen::Vector2d &origin_m, bool off_floor);
+  /// A boundary in `cell` seen from `origin_m`; `above_floor`: above or below the floor's level.
+  void mark_hit(const Cell &cell, const Eigen::Vector2d &origin_m, bool above_floor);
 
   [[nodiscard]] static std::uint64_t key(const Cell &cell);
 
   GridConfig config_;
   float hit_ = 0.0f, miss_ = 0.0f, min_ = 0.0f, max_ = 0.0f;
   std::unordered_map<std::uint64_t, CellState> cells_;
-  /// Cells where something off the floor's level was seen from one viewpoint so far: from where.
-  std::unordered_map<std::uint64_t, Eigen::Vector2f> first_seen_off_;
+  /// Cells where something above the floor was seen from one viewpoint so far: from where.
+  std::unordered_map<std::uint64_t, Eigen::Vector2f> first_seen_above_;
 };
 
 }  // namespace omnislam::grid

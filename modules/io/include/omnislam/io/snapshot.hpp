@@ -32,7 +32,7 @@
 ///               u64 has_grid (0 or 1), and when 1: i32 width, i32 height, f64 resolution_m,
 ///               f64 origin x_m, f64 origin y_m, width x height i8 cells (-1, 0, 100; the
 ///               layout of grid::GridImage), width x height u8 above-floor flags (0, 1;
-///               grid::GridImage::off_floor),
+///               grid::GridImage::above_floor),
 ///               u64 has_graph (0 or 1), and when 1 the keyframe graph
 ///               (slam::KeyframeGraphState): f64 path_m, f64 last frame x_m, y_m, yaw_rad,
 ///               u64 keyframe count, per keyframe f64 x_m, f64 y_m, f64 yaw_rad, f64 path_m,
@@ -44,7 +44,7 @@
 /// ```
 /// Version 4 is version 5 without the grid's above-floor flags, version 3 version 4 without
 /// the graph section, version 2 version 3 without the grid section, version 1 version 2
-/// without the four odometry fields; all are still read (their grid's `off_floor`, before
+/// without the four odometry fields; all are still read (their grid's `above_floor`, before
 /// version 4 their `graph`, and before version 3 their `grid`, are empty).
 
 namespace omnislam::io {
