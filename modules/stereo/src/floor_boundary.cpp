@@ -719,7 +719,10 @@ BoundaryStats FloorBoundaryFinder::find(const FloorGeometry &geometry, const cv:
                    : kNaN;
       if (std::isfinite(boundary_m) && std::isfinite(free_m)) free_m = std::min(free_m, boundary_m);
     }
-    if (std::isfinite(drop_m) && !(boundary_m <= drop_m)) {  // a drop before any boundary
+    // A drop before any boundary, whose lower floor lies in front of it too (a lower floor
+    // seen beyond the wall the column ends at is a twin below a floor edge by chance: the
+    // wall's base whose own twin was missed).
+    if (std::isfinite(drop_m) && !(boundary_m <= drop_m) && !(boundary_m < lower_m)) {
       reach.drop_m[static_cast<std::size_t>(column)] = drop_m;
       reach.lower_m[static_cast<std::size_t>(column)] = lower_m;
       drop_floor_m_[static_cast<std::size_t>(column)] = floor_before_drop_m;
