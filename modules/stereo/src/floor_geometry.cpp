@@ -52,20 +52,17 @@ FloorGeometry::FloorGeometry(const mirror::MirrorModel &model, double camera_hei
   }
 }
 
-float FloorGeometry::floor_outer_row_at(float inner_row) const {
+float FloorGeometry::row_at(const std::vector<float> &per_row, float inner_row) const {
   if (!(inner_row >= 0.0f) || inner_row > static_cast<float>(rows_ - 1)) return kNaN;
   const int below = std::min(rows_ - 2, static_cast<int>(inner_row));
   const float fraction = inner_row - static_cast<float>(below);
-  return floor_outer_row_[index(below)] +
-         fraction * (floor_outer_row_[index(below + 1)] - floor_outer_row_[index(below)]);
+  return per_row[index(below)] + fraction * (per_row[index(below + 1)] - per_row[index(below)]);
 }
 
+float FloorGeometry::floor_outer_row_at(float inner_row) const { return row_at(floor_outer_row_, inner_row); }
+
 float FloorGeometry::lowest_outer_row_at(float inner_row) const {
-  if (!(inner_row >= 0.0f) || inner_row > static_cast<float>(rows_ - 1)) return kNaN;
-  const int below = std::min(rows_ - 2, static_cast<int>(inner_row));
-  const float fraction = inner_row - static_cast<float>(below);
-  return lowest_outer_row_[index(below)] +
-         fraction * (lowest_outer_row_[index(below + 1)] - lowest_outer_row_[index(below)]);
+  return row_at(lowest_outer_row_, inner_row);
 }
 
 double FloorGeometry::floor_range_at(double inner_row) const {

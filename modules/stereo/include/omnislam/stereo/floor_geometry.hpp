@@ -71,6 +71,8 @@ class FloorGeometry {
 
  private:
   [[nodiscard]] static std::size_t index(int row) { return static_cast<std::size_t>(row); }
+  /// A per-row table at a fractional inner row (linear between rows; NaN outside them).
+  [[nodiscard]] float row_at(const std::vector<float> &per_row, float inner_row) const;
 
   mirror::MirrorModel model_;
   double camera_height_m_ = 0.0;
