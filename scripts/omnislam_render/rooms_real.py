@@ -253,6 +253,17 @@ def home_deep_room() -> Room:
     return room
 
 
+def home_ramp_room() -> Room:
+    """A held-out scene (not bundled): the sunken area of `home_step_room` 0.12 m deep with a
+    ramp down into it over its whole length (1.5 m at 8%, an accessible ramp's slope) from its
+    left edge: the ramp's surface is where a robot may drive, its sides and far end are steps
+    down, up to 0.12 m deep."""
+    room = home_step_room()
+    room.name = "home-ramp"
+    room.pits = [Pit("sunken area", (2.4, 1.8), (3.9, 2.7), 0.12, ramp_m=1.5)]
+    return room
+
+
 def _legged_table(name: str, x0: float, y0: float, x1: float, y1: float, height: float) -> list:
     top = Box(f"{name} top", (x0, y0, height - 0.03), (x1, y1, height), TABLE_TOP)
     legs = [Box(f"{name} leg {k + 1}", (lx, ly, 0.0), (lx + 0.05, ly + 0.05, height - 0.03), TABLE_FOOT)

@@ -187,9 +187,20 @@ class Pit:
     lo: tuple[float, float]
     hi: tuple[float, float]
     depth: float
+    ramp_m: float = 0.0  # a ramp down from its lo-x edge, this long (0: none)
 
     def outline(self) -> list[Segment]:
         return rectangle_segments(self.lo, self.hi)
+
+    def ramp_pov(self, texture: str) -> str:
+        """The ramp's wedge, in the floor's material: from the floor's level at lo-x down to
+        the pit's bottom ramp_m along +x, across the pit's width."""
+        (x0, y0), (_, y1) = self.lo, self.hi
+        top, low = _mm(x0, 0.0), _mm(x0 + self.ramp_m, -self.depth)
+        corner = _mm(x0, -self.depth)
+        points = ", ".join(f"<{num(a)}, {num(b)}>" for a, b in (top, low, corner, top))
+        return (f"prism {{ linear_sweep linear_spline {num(y0 * 1000.0)}, {num(y1 * 1000.0)}, 4, {points} "
+                f"{texture} }}  // {self.name}: ramp")
 
     def distance_xy(self, x: float, y: float) -> float:
         return rectangle_distance(self.lo, self.hi, x, y)
@@ -343,6 +354,7 @@ class Room:
             cuts = " ".join(f"box {{ {vec(*_mm(*pit.lo, -pit.depth))}, {vec(*_mm(*pit.hi, 1.0))} }}"
                             for pit in self.pits)
             floor_solid = f"difference {{ plane {{ z, 0 }} {cuts} {floor} }}  // floor with {len(self.pits)} pit(s)"
+            floor_solid += "".join("\n" + pit.ramp_pov(floor) for pit in self.pits if pit.ramp_m > 0.0)
         parts = [
             floor_solid,
             f"plane {{ -z, {num(-self.height * 1000)} pigment {{ {_rgb(self.ceiling_colour)} }} "
