@@ -473,6 +473,20 @@ def test_home_step_pit_is_cut_into_the_floor_and_drawn_in_the_plan():
     assert not any(o.name.startswith("low table") for o in room.objects) and not room.rugs
 
 
+def test_home_ramp_is_a_wedge_in_the_floor_material_down_the_pit():
+    # The held-out ramp: the pit of home-step 0.12 m deep, and a prism swept across its width
+    # whose top runs from the floor's level at its left edge to its bottom at the right edge.
+    room = datasets.HELD_OUT["home-ramp"].room()
+    (pit,) = room.pits
+    assert (pit.depth, pit.ramp_m) == (0.12, 1.5)
+    ramp = next(line for line in room.pov_body().splitlines() if line.strip().endswith(": ramp"))
+    assert ramp.startswith("prism { linear_sweep linear_spline 1800.0, 2700.0, 4, <2400.0, 0.0>, <3900.0, -120.0>, "
+                           "<2400.0, -120.0>, <2400.0, 0.0> ")
+    assert room.floor_texture in ramp
+    # Without a ramp the scene is as before (home-step's renders keep their key).
+    assert ": ramp" not in datasets.HELD_OUT["home-step"].room().pov_body()
+
+
 def test_frames_option_limits_metadata(tmp_path):
     out = tmp_path / "ds"
     subprocess.run(RENDER + ["l-room-2laps", "--out", str(out), "--frames", "7", "--no-images"],
