@@ -18,8 +18,8 @@ from . import odometry as odo
 from . import pov
 from .geometry import Pose, compose, inverse, relative_to_first, write_tum, read_tum
 from .rooms import building_floor, l_room, sim_room
-from .rooms_real import (building_real, checker_room, home_deep_room, home_ramp_room, home_room, home_step_room,
-                         l_room_real, office_real, polished_building, polished_room, sim_room_real)
+from .rooms_real import (building_real, checker_room, home_deep_room, home_ramp_room, home_room, home_stairs_room,
+                         home_step_room, l_room_real, office_real, polished_building, polished_room, sim_room_real)
 from .scene import Room, frame_scene, person_pov
 
 TRAJECTORIES_CSV = Path(__file__).resolve().parent / "data" / "trajectories.csv"
@@ -205,6 +205,9 @@ HELD_OUT: dict[str, DatasetSpec] = {
     "home-ramp": DatasetSpec("home-ramp", home_ramp_room, home_loop, False,
                              "held out: the living room with a ramp down into a sunken area 0.12 m deep, camera 1.05 m",
                              camera_height_m=1.05, grey=True),
+    "home-stairs": DatasetSpec("home-stairs", home_stairs_room, home_loop, False,
+                               "held out: the living room with stairs down (4 x 0.18 m) in place of its sunken area, "
+                               "camera 1.05 m", camera_height_m=1.05, grey=True),
     "polished-room": DatasetSpec("polished-room", polished_room, lambda: facing_travel(table_points("3.2")), False,
                                  "held out: sim-room path facing travel, polished vinyl mirroring the walls",
                                  grey=True),

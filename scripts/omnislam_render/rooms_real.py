@@ -264,6 +264,16 @@ def home_ramp_room() -> Room:
     return room
 
 
+def home_stairs_room() -> Room:
+    """A held-out scene (not bundled): in place of the sunken area of `home_step_room`, stairs
+    down without a railing: four steps of 0.18 m along +x from its left edge, treads 0.3 m,
+    0.72 m deep at the bottom landing (nested pits, each cut deeper than the one before)."""
+    room = home_step_room()
+    room.name = "home-stairs"
+    room.pits = [Pit(f"stairs, step {k + 1}", (2.4 + 0.3 * k, 1.8), (3.9, 2.7), 0.18 * (k + 1)) for k in range(4)]
+    return room
+
+
 def _legged_table(name: str, x0: float, y0: float, x1: float, y1: float, height: float) -> list:
     top = Box(f"{name} top", (x0, y0, height - 0.03), (x1, y1, height), TABLE_TOP)
     legs = [Box(f"{name} leg {k + 1}", (lx, ly, 0.0), (lx + 0.05, ly + 0.05, height - 0.03), TABLE_FOOT)

@@ -487,6 +487,14 @@ def test_home_ramp_is_a_wedge_in_the_floor_material_down_the_pit():
     assert ": ramp" not in datasets.HELD_OUT["home-step"].room().pov_body()
 
 
+def test_home_stairs_are_nested_pits_each_a_step_deeper():
+    room = datasets.HELD_OUT["home-stairs"].room()
+    assert [round(pit.depth, 2) for pit in room.pits] == [0.18, 0.36, 0.54, 0.72]
+    assert [round(pit.lo[0], 2) for pit in room.pits] == [2.4, 2.7, 3.0, 3.3]
+    assert all(pit.hi == (3.9, 2.7) and pit.lo[1] == 1.8 for pit in room.pits)
+    assert room.pov_body().count("box { <") >= 4
+
+
 def test_frames_option_limits_metadata(tmp_path):
     out = tmp_path / "ds"
     subprocess.run(RENDER + ["l-room-2laps", "--out", str(out), "--frames", "7", "--no-images"],
