@@ -102,8 +102,9 @@ class OccupancyGrid {
   /// excluding the cell of `to_m`.
   template <typename Visit>
   void traverse(const Eigen::Vector2d &from_m, const Eigen::Vector2d &to_m, Visit &&visit) const;
-  /// A boundary in `cell` seen from `origin_m`; `above_floor`: above or below the floor's level.
-  void mark_hit(const Cell &cell, const Eigen::Vector2d &origin_m, bool above_floor);
+  /// A boundary in `cell` seen from `origin_m`; `elevated`: something above the floor (kept
+  /// against floor seen under it once two viewpoints saw it there).
+  void mark_hit(const Cell &cell, const Eigen::Vector2d &origin_m, bool elevated);
 
   [[nodiscard]] static std::uint64_t key(const Cell &cell);
 
