@@ -80,7 +80,6 @@ struct BoundaryStats {
   float twin_spread_px = 0.0f;  ///< the lobes' sub-pixel placement error (Laplace scale, rows)
 };
 
-/// Scratch images between frames; not thread-safe (one per thread).
 /// What each panorama column showed of the floor (NaN where nothing).
 struct FloorReach {
   /// How far the floor was seen to be free.
@@ -93,6 +92,7 @@ struct FloorReach {
   std::vector<float> lower_m;
 };
 
+/// Scratch images between frames; not thread-safe (one per thread).
 class FloorBoundaryFinder {
  public:
   explicit FloorBoundaryFinder(const FloorBoundaryConfig &config = {});
@@ -126,8 +126,9 @@ class FloorBoundaryFinder {
   /// The current column's outer edge of polarity `sign` nearest `outer_row` and its offset
   /// from it (nullptr and infinity when the column has none).
   /// Whether edge `index` of the current column is a surface below the floor: its nearest
-  /// same-polarity outer edge below the floor's row, beyond the contact margin, triangulates
-  /// under the floor plane. Returns that point's range in plan, NaN when it is not.
+  /// same-polarity outer edge below the floor's row, beyond the contact margin and no lower
+  /// than a floor one camera height down would put it, triangulates under the floor plane.
+  /// Returns that point's range in plan, NaN when it is not.
   [[nodiscard]] float below_floor(int column, std::size_t index, float floor_row, double floor_height_m,
                                   const RowTriangulator &triangulator) const;
   /// Keeps the drops along a rim (a run of at least kDropRimColumns columns with like ranges;
