@@ -123,8 +123,6 @@ class FloorBoundaryFinder {
   /// floor (the twin's offset from a surface standing at the edge against its offset from
   /// the floor, in units of the frame's placement error).
   [[nodiscard]] bool floor_seen_beyond(std::size_t index, float contact_row, double rows_llr) const;
-  /// The current column's outer edge of polarity `sign` nearest `outer_row` and its offset
-  /// from it (nullptr and infinity when the column has none).
   /// Whether edge `index` of the current column is a surface below the floor: its nearest
   /// same-polarity outer edge below the floor's row, beyond the contact margin and no lower
   /// than a floor one camera height down would put it, triangulates under the floor plane.
@@ -140,6 +138,8 @@ class FloorBoundaryFinder {
     const vision::EdgePoint *edge = nullptr;
     float offset = std::numeric_limits<float>::infinity();
   };
+  /// The current column's outer edge of polarity `sign` nearest `outer_row` and its offset
+  /// from it (nullptr and infinity when the column has none).
   [[nodiscard]] Twin nearest_twin(float outer_row, int sign) const;
   [[nodiscard]] float outer_at(float row, int column) const;
   /// One column-major line (a column of a lobe) at a fractional row, clamped to the lobe.
