@@ -511,9 +511,13 @@ int FloorBoundaryFinder::keep_drops_along_rims(FloorReach &reach) {
   int kept = 0;
   for (int offset = 0; offset < columns;) {
     const int start = first + offset;
-    int length = std::isfinite(at(start)) ? 1 : 0;
-    while (length > 0 && length < columns && alike(start + length)) ++length;
-    for (int k = 0; k < std::max(length, 1); ++k) {
+    if (!std::isfinite(at(start))) {
+      ++offset;
+      continue;
+    }
+    int length = 1;
+    while (length < columns && alike(start + length)) ++length;
+    for (int k = 0; k < length; ++k) {
       const auto c = static_cast<std::size_t>((start + k) % columns);
       if (length >= kDropRimColumns) {
         ++kept;
@@ -523,7 +527,7 @@ int FloorBoundaryFinder::keep_drops_along_rims(FloorReach &reach) {
         reach.lower_m[c] = kNaN;
       }
     }
-    offset += std::max(length, 1);
+    offset += length;
   }
   return kept;
 }
@@ -594,10 +598,12 @@ BoundaryStats FloorBoundaryFinder::find(const FloorGeometry &geometry, const cv:
       //    drop bounds the free floor, it is not a scan point.)
       if (contact == nullptr && match == nullptr && !std::isfinite(drop_m)) {
         lower_m = below_floor(column, index, floor_row, floor_height_m, triangulator);
-        if (std::isfinite(lower_m)) drop_m = static_cast<float>(geometry_->floor_range_at(edge.row_subpx));
-        floor_before_drop_m = std::isfinite(farthest_floor_row)
-                                  ? static_cast<float>(geometry_->floor_range_at(farthest_floor_row))
-                                  : 0.0f;
+        if (std::isfinite(lower_m)) {
+          drop_m = static_cast<float>(geometry_->floor_range_at(edge.row_subpx));
+          floor_before_drop_m = std::isfinite(farthest_floor_row)
+                                    ? static_cast<float>(geometry_->floor_range_at(farthest_floor_row))
+                                    : 0.0f;
+        }
       }
       //    A twin less than the frame's placement error above the floor's row does not put
       //    the edge above the floor by itself: the pixels beyond decide, as in step 3.

@@ -12,6 +12,11 @@ constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
 
 float row_or_nan(const std::optional<double> &row) { return row ? static_cast<float>(*row) : kNaN; }
 
+// Range from the axis where `ray` comes down to `height_m` (relative to the pinhole).
+double range_at_height(const mirror::MeridianRay &ray, double height_m) {
+  return ray.origin.range_m + (ray.origin.height_m - height_m) * std::tan(ray.theta_rad);
+}
+
 }  // namespace
 
 FloorGeometry::FloorGeometry(const mirror::MirrorModel &model, double camera_height_m)
@@ -33,11 +38,9 @@ FloorGeometry::FloorGeometry(const mirror::MirrorModel &model, double camera_hei
     if (!std::isfinite(range_m)) continue;
     floor_range_m_[index(row)] = static_cast<float>(range_m);
     floor_outer_row_[index(row)] = row_or_nan(model.project_row(Lobe::kOuter, {range_m, -camera_height_m}));
-    const mirror::MeridianRay &ray = rays.back();
-    const double lowest_m = -2.0 * camera_height_m;
-    const double lowest_range_m =
-        ray.origin.range_m + (ray.origin.height_m - lowest_m) * std::tan(ray.theta_rad);
-    lowest_outer_row_[index(row)] = row_or_nan(model.project_row(Lobe::kOuter, {lowest_range_m, lowest_m}));
+    const double lowest_m = -2.0 * camera_height_m;  // a floor one camera height down
+    lowest_outer_row_[index(row)] =
+        row_or_nan(model.project_row(Lobe::kOuter, {range_at_height(rays.back(), lowest_m), lowest_m}));
   }
   for (int base = 0; base < rows_; ++base) {
     const double wall_m = floor_range_m_[index(base)];
@@ -70,7 +73,7 @@ double FloorGeometry::floor_range_at(double inner_row) const {
   const mirror::MeridianRay ray =
       model_.back_project(Lobe::kInner, model_.radius_px_of_row(Lobe::kInner, inner_row));
   if (!(ray.theta_rad < std::numbers::pi / 2.0)) return std::numeric_limits<double>::quiet_NaN();
-  return ray.origin.range_m + (ray.origin.height_m + camera_height_m_) * std::tan(ray.theta_rad);
+  return range_at_height(ray, -camera_height_m_);
 }
 
 }  // namespace omnislam::stereo

@@ -16,9 +16,8 @@
 /// cell since the last added scan, or turned by the angle that moves the end of that scan's
 /// longest ray by a cell. A robot standing still adds nothing. An added scan is kept for
 /// the rebuilds when its caller says so (the service keeps those the SLAM keeps, so the
-/// grid's memory is bounded as the map's is), at most 7.2 kB per kept scan of 360 rays (20 bytes
-/// a ray). Not
-/// thread-safe.
+/// grid's memory is bounded as the map's is), at most 7.2 kB per kept scan of 360 rays (20
+/// bytes a ray). Not thread-safe.
 
 namespace omnislam::grid {
 
