@@ -70,6 +70,24 @@ void building_row(int side) {
       quantile(frame_ms, 0.99), quantile(frame_ms, 1.0));
 }
 
+// The starts not localized, as runs of consecutive frames ("153-179"): a run is a stretch of
+// the path whose next max_frames frames never tell it from somewhere else on the map.
+void print_missed(const std::vector<int> &missed) {
+  if (missed.empty()) return;
+  std::printf("  not localized, starting at frames:");
+  for (std::size_t i = 0; i < missed.size();) {
+    std::size_t j = i;
+    while (j + 1 < missed.size() && missed[j + 1] == missed[j] + 1) ++j;
+    if (j == i) {
+      std::printf(" %d", missed[i]);
+    } else {
+      std::printf(" %d-%d", missed[i], missed[j]);
+    }
+    i = j + 1;
+  }
+  std::printf("\n");
+}
+
 }  // namespace
 
 int main(int argc, char **argv) {
@@ -102,6 +120,7 @@ int main(int argc, char **argv) {
                 outcome.localized > 0 ? static_cast<double>(outcome.frames_needed) / outcome.localized : 0.0,
                 quantile(outcome.frame_ms, 0.5), quantile(outcome.frame_ms, 0.99),
                 quantile(outcome.frame_ms, 1.0));
+    print_missed(outcome.missed);
   }
   if (defaults) {
     for (const int side : {4, 8}) building_row(side);

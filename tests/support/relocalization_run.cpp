@@ -53,6 +53,7 @@ RelocalizationOutcome relocalize_from_frames(const LocalizationRun &run, int max
   for (int start = std::max(first, 0); start < last && start + max_frames <= frames; ++start) {
     slam::Relocalizer relocalizer(run.map);
     ++outcome.starts;
+    const int localized_before = outcome.localized;
     for (int f = start; f < start + max_frames; ++f) {
       const auto index = static_cast<std::size_t>(f);
       const auto begin = std::chrono::steady_clock::now();
@@ -76,6 +77,7 @@ RelocalizationOutcome relocalize_from_frames(const LocalizationRun &run, int max
       }
       break;
     }
+    if (outcome.localized == localized_before) outcome.missed.push_back(start + 1);
   }
   return outcome;
 }

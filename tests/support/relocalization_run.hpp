@@ -35,6 +35,7 @@ struct RelocalizationOutcome {
   double worst_error_m = 0.0;  ///< of the correct ones
   double worst_error_deg = 0.0;
   std::vector<double> frame_ms;  ///< time of every relocaliser frame before localization
+  std::vector<int> missed;       ///< the starts (1-based frames) not localized within max_frames
 };
 
 /// Starts a fresh relocaliser at every frame that has `max_frames` frames after it, and feeds
