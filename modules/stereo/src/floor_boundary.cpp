@@ -529,7 +529,39 @@ int FloorBoundaryFinder::keep_drops_along_rims(FloorReach &reach) {
     }
     offset += length;
   }
+  close_rim_gaps(reach);
   return kept;
+}
+
+void FloorBoundaryFinder::close_rim_gaps(FloorReach &reach) const {
+  // A rim is one edge in the world: where two kept runs at like ranges are a few columns
+  // apart (no longer than a run must be), the columns between saw no edge of the lower floor
+  // and the rim runs on there too. Their floor is claimed only up to the rim (beyond it,
+  // unknown: no drop is marked where none was seen).
+  const std::vector<float> &drop_m = reach.drop_m;
+  const int columns = static_cast<int>(drop_m.size());
+  std::vector<int> kept_columns;
+  for (int column = 0; column < columns; ++column)
+    if (std::isfinite(drop_m[static_cast<std::size_t>(column)])) kept_columns.push_back(column);
+  if (kept_columns.size() < 2) return;
+  for (std::size_t i = 0; i < kept_columns.size(); ++i) {
+    const int from = kept_columns[i];
+    const int to = kept_columns[(i + 1) % kept_columns.size()];
+    const int gap = (to - from - 1 + columns) % columns;
+    if (gap < 1 || gap > kDropRimColumns) continue;
+    const float from_m = drop_floor_m_[static_cast<std::size_t>(from)];
+    const float to_m = drop_floor_m_[static_cast<std::size_t>(to)];
+    const float from_drop_m = drop_m[static_cast<std::size_t>(from)];
+    const float to_drop_m = drop_m[static_cast<std::size_t>(to)];
+    if (std::abs(to_drop_m - from_drop_m) > kDropAlike * std::max(from_drop_m, to_drop_m)) continue;
+    for (int k = 1; k <= gap; ++k) {
+      const auto c = static_cast<std::size_t>((from + k) % columns);
+      const float t = static_cast<float>(k) / static_cast<float>(gap + 1);
+      const float rim_m = from_m + t * (to_m - from_m);
+      if (std::isfinite(reach.free_m[c]) && std::isfinite(rim_m))
+        reach.free_m[c] = std::min(reach.free_m[c], rim_m);
+    }
+  }
 }
 
 BoundaryStats FloorBoundaryFinder::find(const FloorGeometry &geometry, const cv::Mat &inner_texture,

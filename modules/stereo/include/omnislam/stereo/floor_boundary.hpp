@@ -133,6 +133,9 @@ class FloorBoundaryFinder {
   /// NaN for the others) and stops their columns' free floor where it was seen before the
   /// drop; returns how many were kept.
   int keep_drops_along_rims(FloorReach &reach);
+  /// Between two kept runs at like ranges at most kDropRimColumns apart, the columns that saw
+  /// no drop are free only up to the rim (interpolated between the runs' ends).
+  void close_rim_gaps(FloorReach &reach) const;
   std::vector<float> drop_floor_m_;  ///< per column, how far the floor was seen before its drop
   struct Twin {
     const vision::EdgePoint *edge = nullptr;
