@@ -533,14 +533,15 @@ int FloorBoundaryFinder::keep_drops_along_rims(FloorReach &reach) {
   return kept;
 }
 
-void FloorBoundaryFinder::close_rim_gaps(FloorReach &reach) const {
+void FloorBoundaryFinder::close_rim_gaps(FloorReach &reach) {
   // A rim is one edge in the world: where two kept runs at like ranges are a few columns
   // apart (no longer than a run must be), the columns between saw no edge of the lower floor
   // and the rim runs on there too. Their floor is claimed only up to the rim (beyond it,
   // unknown: no drop is marked where none was seen).
   const std::vector<float> &drop_m = reach.drop_m;
   const int columns = static_cast<int>(drop_m.size());
-  std::vector<int> kept_columns;
+  std::vector<int> &kept_columns = rim_columns_;
+  kept_columns.clear();
   for (int column = 0; column < columns; ++column)
     if (std::isfinite(drop_m[static_cast<std::size_t>(column)])) kept_columns.push_back(column);
   if (kept_columns.size() < 2) return;

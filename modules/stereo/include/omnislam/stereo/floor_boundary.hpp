@@ -135,7 +135,8 @@ class FloorBoundaryFinder {
   int keep_drops_along_rims(FloorReach &reach);
   /// Between two kept runs at like ranges at most kDropRimColumns apart, the columns that saw
   /// no drop are free only up to the rim (interpolated between the runs' ends).
-  void close_rim_gaps(FloorReach &reach) const;
+  void close_rim_gaps(FloorReach &reach);
+  std::vector<int> rim_columns_;     ///< close_rim_gaps' scratch: the columns with a kept drop
   std::vector<float> drop_floor_m_;  ///< per column, how far the floor was seen before its drop
   struct Twin {
     const vision::EdgePoint *edge = nullptr;
