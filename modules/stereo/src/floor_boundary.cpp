@@ -43,6 +43,9 @@ constexpr float kTwinSearchRows = 2.5f;
 constexpr float kDropAlike = 0.1f;
 constexpr int kDropRimColumns = 4;
 
+// Whether a drop at `other_m` goes on from one at `range_m` (kDropAlike of range_m).
+bool drops_alike(float range_m, float other_m) { return std::abs(range_m - other_m) <= kDropAlike * range_m; }
+
 int polarity(const vision::EdgeImage &edges, int row, int column) {
   return edges.grad_row.at<std::int16_t>(row, column) >= 0 ? 1 : -1;
 }
@@ -502,8 +505,7 @@ int FloorBoundaryFinder::keep_drops_along_rims(FloorReach &reach) {
   const auto at = [&](int column) { return drop_m[static_cast<std::size_t>((column + columns) % columns)]; };
   const auto alike = [&](int column) {  // column's drop goes on from the one before it
     const float range_m = at(column), before_m = at(column - 1);
-    return std::isfinite(range_m) && std::isfinite(before_m) &&
-           std::abs(range_m - before_m) <= kDropAlike * range_m;
+    return std::isfinite(range_m) && std::isfinite(before_m) && drops_alike(range_m, before_m);
   };
   int first = 0;  // a run's first column: wrapped runs are walked whole
   while (first < columns && alike(first)) ++first;
@@ -529,15 +531,14 @@ int FloorBoundaryFinder::keep_drops_along_rims(FloorReach &reach) {
     }
     offset += length;
   }
-  close_rim_gaps(reach);
   return kept;
 }
 
 void FloorBoundaryFinder::close_rim_gaps(FloorReach &reach) {
   // A rim is one edge in the world: where two kept runs at like ranges are a few columns
   // apart (no longer than a run must be), the columns between saw no edge of the lower floor
-  // and the rim runs on there too. Their floor is claimed only up to the rim (beyond it,
-  // unknown: no drop is marked where none was seen).
+  // and the rim runs on there too. Their floor is claimed only as far as the runs' columns
+  // saw it (beyond, unknown: no drop is marked where none was seen).
   const std::vector<float> &drop_m = reach.drop_m;
   const int columns = static_cast<int>(drop_m.size());
   std::vector<int> &kept_columns = rim_columns_;
@@ -554,13 +555,13 @@ void FloorBoundaryFinder::close_rim_gaps(FloorReach &reach) {
     const float to_m = drop_floor_m_[static_cast<std::size_t>(to)];
     const float from_drop_m = drop_m[static_cast<std::size_t>(from)];
     const float to_drop_m = drop_m[static_cast<std::size_t>(to)];
-    if (std::abs(to_drop_m - from_drop_m) > kDropAlike * std::max(from_drop_m, to_drop_m)) continue;
+    if (!drops_alike(std::max(from_drop_m, to_drop_m), std::min(from_drop_m, to_drop_m))) continue;
     for (int k = 1; k <= gap; ++k) {
       const auto c = static_cast<std::size_t>((from + k) % columns);
       const float t = static_cast<float>(k) / static_cast<float>(gap + 1);
-      const float rim_m = from_m + t * (to_m - from_m);
-      if (std::isfinite(reach.free_m[c]) && std::isfinite(rim_m))
-        reach.free_m[c] = std::min(reach.free_m[c], rim_m);
+      // A kept drop's column always has its floor-before range (0 where none was seen).
+      if (std::isfinite(reach.free_m[c]))
+        reach.free_m[c] = std::min(reach.free_m[c], from_m + t * (to_m - from_m));
     }
   }
 }
@@ -768,6 +769,7 @@ BoundaryStats FloorBoundaryFinder::find(const FloorGeometry &geometry, const cv:
     }
   }
   stats.drops = keep_drops_along_rims(reach);
+  close_rim_gaps(reach);
   return stats;
 }
 

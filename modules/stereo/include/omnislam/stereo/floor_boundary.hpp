@@ -134,7 +134,8 @@ class FloorBoundaryFinder {
   /// drop; returns how many were kept.
   int keep_drops_along_rims(FloorReach &reach);
   /// Between two kept runs at like ranges at most kDropRimColumns apart, the columns that saw
-  /// no drop are free only up to the rim (interpolated between the runs' ends).
+  /// no drop are free only as far as the runs' columns saw the floor before their drops
+  /// (interpolated between the runs' ends). After keep_drops_along_rims.
   void close_rim_gaps(FloorReach &reach);
   std::vector<int> rim_columns_;     ///< close_rim_gaps' scratch: the columns with a kept drop
   std::vector<float> drop_floor_m_;  ///< per column, how far the floor was seen before its drop
