@@ -13,13 +13,13 @@ fail() { echo "FAIL: $*" >&2; exit 1; }
 "$omnislam" map save "$work/run" "$work/state.snap" >"$work/save.txt"
 points=$(($(wc -l <"$work/run/map.csv") - 1))
 [ "$points" -gt 100 ] || fail "the replay mapped only $points points"
-grep -q "saved $points map points, the occupancy grid and the pose of frame 10" "$work/save.txt" || fail "save: $(cat "$work/save.txt")"
+grep -q "saved $points map points, the occupancy grid, the keyframe graph and the pose of frame 10" "$work/save.txt" || fail "save: $(cat "$work/save.txt")"
 
 "$omnislam" map info "$work/state.snap" >"$work/info.txt"
 last=$(tail -n 1 "$work/run/trajectory.tum")
 x=$(echo "$last" | awk '{ printf "%.4f", $2 }')
 y=$(echo "$last" | awk '{ printf "%.4f", $3 }')
-grep -q "^version: 5$" "$work/info.txt" || fail "info: no version line"
+grep -q "^version: 6$" "$work/info.txt" || fail "info: no version line"
 grep -q "^map points: $points " "$work/info.txt" || fail "info: map points differ from map.csv ($points)"
 grep -q "^pose: x $x m, y $y m, .* t 0.900 s$" "$work/info.txt" || fail "info: pose is not the last of trajectory.tum ($x, $y)"
 grep -Eq "^frames: 10, integrated [0-9]+, not integrated [0-9]+, skipped 0, dropped 0$" "$work/info.txt" ||
@@ -27,7 +27,16 @@ grep -Eq "^frames: 10, integrated [0-9]+, not integrated [0-9]+, skipped 0, drop
 
 width_height=$(sed -n 2p "$work/run/map.pgm")
 grep -q "^occupancy grid: ${width_height/ / x } cells at 0.050 m" "$work/info.txt" || fail "info: $(grep grid "$work/info.txt")"
-grep -q "^keyframe graph: none$" "$work/info.txt" || fail "info: a replay's output holds no keyframe graph: $(grep graph "$work/info.txt")"
+# The replay's map.snapshot gives the snapshot its keyframe graph (one scan per frame here).
+grep -Eq "^keyframe graph: [0-9]+ keyframes, [0-9]+ edges \(0 loop\), [0-9]+ integrated scans, path [0-9.]+ m$" "$work/info.txt" ||
+  fail "info: no keyframe graph from the replay's map.snapshot: $(grep graph "$work/info.txt")"
+cmp <("$omnislam" map info "$work/run/map.snapshot" | grep "^keyframe graph") <(grep "^keyframe graph" "$work/info.txt") ||
+  fail "info: the saved keyframe graph is not the replay's"
+# Without it (an older replay's output) the snapshot holds none.
+mkdir -p "$work/old-run"
+cp "$work/run/"{trajectory.tum,covariance.csv,summary.json,map.csv,map.yaml,map.pgm} "$work/old-run/"
+"$omnislam" map save "$work/old-run" "$work/old.snap" >/dev/null
+"$omnislam" map info "$work/old.snap" | grep -q "^keyframe graph: none$" || fail "info: a graph from an output without map.snapshot"
 
 # map export: from the replay's directory and from the snapshot, the replay's own files.
 for source in run state.snap; do
@@ -78,7 +87,7 @@ check_bad() {  # source, expected message
 }
 check_bad "$work/absent.snap" ".*/absent.snap: no such file or directory"
 check_bad "$work/run/map.pgm" ".*/run/map.pgm: not an omnislam snapshot (bad magic)"
-check_bad "$work/future.snap" ".*/future.snap: unsupported snapshot version 9 (this build reads versions 1 to 5)"
+check_bad "$work/future.snap" ".*/future.snap: unsupported snapshot version 9 (this build reads versions 1 to 6)"
 check_bad "$work/empty-dir" ".*/empty-dir: no map.yaml (not an omnislam replay or omnislamd output directory)"
 
 "$omnislam" map load "$work/state.snap" --out "$work/loaded" >/dev/null

@@ -158,13 +158,13 @@ TEST_CASE("snapshot: truncation, bit flips, other versions and bad values are re
 
 TEST_CASE("snapshot: a future version or impossible values are named even with a valid checksum",
           "[io][snapshot]") {
-  // A version-6 file (as a newer build would write it) has a valid CRC of its own.
-  std::vector<std::uint8_t> v6 = omnislam::io::encode_snapshot(example());
-  v6[8] = 6;
-  omnislam::test::reseal_snapshot(v6);
+  // A version-7 file (as a newer build would write it) has a valid CRC of its own.
+  std::vector<std::uint8_t> v7 = omnislam::io::encode_snapshot(example());
+  v7[8] = 7;
+  omnislam::test::reseal_snapshot(v7);
   CHECK_THROWS_WITH(
-      omnislam::io::decode_snapshot(v6, "v6.snap"),
-      Catch::Equals("v6.snap: unsupported snapshot version 6 (this build reads versions 1 to 5)"));
+      omnislam::io::decode_snapshot(v7, "v7.snap"),
+      Catch::Equals("v7.snap: unsupported snapshot version 7 (this build reads versions 1 to 6)"));
 
   Snapshot bad = example();
   bad.points[3].hits = 0;
@@ -253,7 +253,7 @@ TEST_CASE(
   const std::vector<std::uint8_t> v5 = omnislam::io::encode_snapshot(written);
   CHECK(v5.size() == 24 + 200 + 24 * 50 + 8 + 32 + 21 + 21 + 8);
   const Snapshot read = omnislam::io::decode_snapshot(v5, "grid.snap");
-  CHECK(read.version == 5);
+  CHECK(read.version == 6);  // without a graph version 6's bytes are version 5's
   REQUIRE(read.grid);
   CHECK(read.grid->width == 7);
   CHECK(read.grid->height == 3);
@@ -340,6 +340,8 @@ KeyframeGraphState example_graph() {
   KeyframeGraphState g;
   for (int k = 0; k < 3; ++k) {
     KeyframeGraphState::SavedKeyframe keyframe{{0.5 * k, 0.1 * k, 0.3 * k - 0.1}, 0.6 * k, {}};
+    keyframe.covariance << 4e-6 * (k + 1), 1e-7, 2e-8 * k, 1e-7, 9e-6 * (k + 1), 0.0, 2e-8 * k, 0.0,
+        3e-5 * (k + 1);
     for (int scan = 0; scan < 40; ++scan) {
       keyframe.scans_keyframe.push_back(std::make_shared<const omnislam::slam::Points2>(
           omnislam::slam::Points2{{1.0 + k, 0.01 * scan}, {-0.5, 2.0 - k}, {0.125 * scan, -1.0 / 3.0}}));
@@ -386,12 +388,12 @@ TEST_CASE("snapshot: version 4 and later carry the keyframe graph exactly; re-en
   Snapshot written = example_with_graph();
   written.grid = example_grid();
   const std::vector<std::uint8_t> bytes = omnislam::io::encode_snapshot(written);
-  // The graph section: 8 (has_graph) + 32 + 3 keyframes x (40 + 40 scans x (8 + 3 x 16))
+  // The graph section: 8 (has_graph) + 32 + 3 keyframes x (40 + 72 + 40 scans x (8 + 3 x 16))
   // + 8 + 120 x 8 + 8 + 3 x 112.
-  CHECK(bytes.size() ==
-        24 + 200 + 24 * 50 + 8 + 32 + 21 + 21 + 8 + 32 + 8 + 3 * (40 + 40 * 56) + 8 + 960 + 8 + 336);
+  const std::size_t graph_at = 24 + 200 + 24 * 50 + 8 + 32 + 21 + 21;
+  CHECK(bytes.size() == graph_at + 8 + 32 + 8 + 3 * (40 + 72 + 40 * 56) + 8 + 960 + 8 + 336);
   const Snapshot read = omnislam::io::decode_snapshot(bytes, "graph.snap");
-  CHECK(read.version == 5);
+  CHECK(read.version == 6);
   REQUIRE(read.grid);
   REQUIRE(read.graph);
   const KeyframeGraphState &want = *written.graph, &got = *read.graph;
@@ -399,6 +401,7 @@ TEST_CASE("snapshot: version 4 and later carry the keyframe graph exactly; re-en
   for (std::size_t k = 0; k < 3; ++k) {
     CHECK(same_pose(got.keyframes[k].T_map_keyframe, want.keyframes[k].T_map_keyframe));
     CHECK(got.keyframes[k].path_m == want.keyframes[k].path_m);
+    CHECK(got.keyframes[k].covariance == want.keyframes[k].covariance);
     REQUIRE(got.keyframes[k].scans_keyframe.size() == 40);
     for (std::size_t scan = 0; scan < 40; ++scan)
       CHECK(*got.keyframes[k].scans_keyframe[scan] == *want.keyframes[k].scans_keyframe[scan]);
@@ -415,6 +418,26 @@ TEST_CASE("snapshot: version 4 and later carry the keyframe graph exactly; re-en
   CHECK(got.path_m == 1.4);
   CHECK(same_pose(got.last_frame, want.last_frame));
   CHECK(omnislam::io::encode_snapshot(read) == bytes);
+
+  // Version 5: version 6 without the keyframes' covariances (72 bytes after each keyframe's
+  // pose and path), still read, with zero covariances.
+  std::vector<std::uint8_t> v5 = bytes;
+  for (int k = 2; k >= 0; --k) {
+    const std::size_t at = graph_at + 8 + 32 + 8 + static_cast<std::size_t>(k) * (40 + 72 + 40 * 56) + 32;
+    v5.erase(v5.begin() + static_cast<std::ptrdiff_t>(at), v5.begin() + static_cast<std::ptrdiff_t>(at + 72));
+  }
+  v5[8] = 5;
+  omnislam::test::reseal_snapshot(v5);
+  const Snapshot five = omnislam::io::decode_snapshot(v5, "v5.snap");
+  CHECK(five.version == 5);
+  REQUIRE(five.graph);
+  REQUIRE(five.graph->keyframes.size() == 3);
+  for (std::size_t k = 0; k < 3; ++k) {
+    CHECK(same_pose(five.graph->keyframes[k].T_map_keyframe, want.keyframes[k].T_map_keyframe));
+    CHECK(five.graph->keyframes[k].covariance.isZero());
+    CHECK(*five.graph->keyframes[k].scans_keyframe[39] == *want.keyframes[k].scans_keyframe[39]);
+  }
+  CHECK(five.graph->edges.size() == 3);
 
   // Without a graph: one u64 0 where the graph would be.
   const std::vector<std::uint8_t> none = omnislam::io::encode_snapshot(example());
@@ -464,6 +487,10 @@ TEST_CASE("snapshot: a version-4 keyframe graph that does not hold together is r
           "keyframe 1 scan point x_m is not a finite number");
   rejects(with_graph([](Graph &g) { g.edges[2].T_from_to.yaw_rad = INFINITY; }),
           "edge 2 yaw_rad is not a finite number");
+  rejects(with_graph([](Graph &g) { g.keyframes[1].covariance(2, 2) = -1e-3; }),
+          "keyframe graph: keyframe 1: covariance is not symmetric positive semi-definite");
+  rejects(with_graph([](Graph &g) { g.keyframes[2].covariance(0, 1) = 1e-3; }),
+          "keyframe graph: keyframe 2: covariance is not symmetric positive semi-definite");
 
   // Flags and counts edited in the bytes (the writer cannot produce them).
   const std::vector<std::uint8_t> good = omnislam::io::encode_snapshot(example_with_graph());

@@ -84,6 +84,34 @@ TEST_CASE("keyframe graph: its state restores the keyframes, scans, edges and pa
   CHECK_THROWS_AS(KeyframeGraph(KeyframeConfig{}, broken, true), std::invalid_argument);
 }
 
+TEST_CASE("keyframe graph: a keyframe's covariance is the mean of its scans' frames', carried to it",
+          "[slam][graph]") {
+  KeyframeGraph graph;
+  const Eigen::Matrix3d tracked = Eigen::Vector3d(1e-4, 1e-4, 1e-5).asDiagonal();
+  const Eigen::Matrix3d first = Eigen::Vector3d(4e-6, 9e-6, 1e-6).asDiagonal();
+  (void)graph.add_integrated(some_scan(0.0), pose(0.0, 0.0, 0.0), tracked);
+  graph.add_scan_covariance(first, pose(0.0, 0.0, 0.0));
+  CHECK(graph.keyframes()[0].covariance.isApprox(first));
+  // A frame 0.2 m on joins the keyframe: its heading variance swings its scan about it,
+  // 0.2 m from the keyframe (y variance + 0.04 m2 x yaw variance, the x-yaw cross term).
+  const Eigen::Matrix3d second = Eigen::Vector3d(1e-5, 1e-5, 1e-4).asDiagonal();
+  CHECK_FALSE(graph.add_integrated(some_scan(0.2), pose(0.2, 0.0, 0.0), tracked));
+  graph.add_scan_covariance(second, pose(0.2, 0.0, 0.0));
+  Eigen::Matrix3d carried = second;
+  carried(1, 1) += 0.04 * 1e-4;
+  carried(1, 2) = carried(2, 1) = -0.2 * 1e-4;
+  CHECK(graph.keyframes()[0].covariance.isApprox(0.5 * (first + carried), 1e-12));
+  // The state carries it, and a restored graph has it back.
+  const KeyframeGraphState state = graph.state();
+  CHECK(state.keyframes[0].covariance == graph.keyframes()[0].covariance);
+  const KeyframeGraph restored(KeyframeConfig{}, state, true);
+  CHECK(restored.keyframes()[0].covariance == graph.keyframes()[0].covariance);
+  KeyframeGraphState broken = state;
+  broken.keyframes[0].covariance(2, 2) = -1.0;
+  CHECK(keyframe_graph_state_error(broken) ==
+        "keyframe 0: covariance is not symmetric positive semi-definite");
+}
+
 TEST_CASE(
     "keyframe graph: a chained resume joins the next keyframe to the saved last one, an unchained "
     "one starts a keyframe without an edge",

@@ -1,5 +1,6 @@
 #include <algorithm>
 #include <catch2/catch.hpp>
+#include <optional>
 #include <random>
 #include <vector>
 
@@ -8,7 +9,10 @@
 #include "synthetic_room.hpp"
 
 // Resuming from a saved state and localization on a fixed map (the service's persistence).
+using omnislam::slam::FrameEstimate;
+using omnislam::slam::KeyframeGraphState;
 using omnislam::slam::MapPoint;
+using omnislam::slam::ResumedGraph;
 using omnislam::slam::Slam;
 using omnislam::slam::SlamConfig;
 using omnislam::test::pose;
@@ -94,6 +98,44 @@ TEST_CASE("localization only: tracks the pose on a saved map and never changes i
   CHECK(track.accepted >= static_cast<int>(0.9 * truth.size()));
   CHECK(localizer.map().integrations() == integrations);
   CHECK(same_points(localizer.map().points(), saved));
+}
+
+TEST_CASE("localization only on a saved graph: each pose's covariance adds how far the map may be off there",
+          "[slam][resume]") {
+  const auto truth = tour();
+  Slam mapping;
+  (void)run(mapping, truth, 0, truth.size(), 1);
+  const std::optional<KeyframeGraphState> graph = mapping.graph_state();
+  REQUIRE(graph);
+  REQUIRE(graph->keyframes.size() > 3);
+  // The mapping run's covariances grew along its path: the last keyframes' are the largest.
+  const Eigen::Matrix3d &last = graph->keyframes.back().covariance;
+  CHECK(last.trace() > graph->keyframes[1].covariance.trace());
+  CHECK(graph->keyframes.front().covariance.trace() < last.trace());
+
+  SlamConfig config;
+  config.localization_only = true;
+  Slam without(config), with(config);
+  without.resume(mapping.map().points(), mapping.map().integrations(), Eigen::Isometry2d::Identity(),
+                 Eigen::Matrix3d::Zero());
+  with.resume(mapping.map().points(), mapping.map().integrations(), Eigen::Isometry2d::Identity(),
+              Eigen::Matrix3d::Zero(), {}, ResumedGraph{*graph, false});
+  CHECK(without.map_uncertainty_at(truth.back()).isZero());
+  const Eigen::Isometry2d at_last = omnislam::slam::planar_pose(
+      graph->keyframes.back().T_map_keyframe.x_m, graph->keyframes.back().T_map_keyframe.y_m,
+      graph->keyframes.back().T_map_keyframe.yaw_rad);
+  CHECK(with.map_uncertainty_at(at_last).isApprox(last, 1e-9));
+  // Same scans, same poses; only the published covariances differ, by the map's where each is.
+  const auto odometry = omnislam::slam::apply_thesis_odometry_noise(truth, 9);
+  const auto walls = omnislam::test::l_room();
+  std::mt19937_64 rng_a(9), rng_b(9);
+  for (std::size_t i = 0; i < truth.size(); ++i) {
+    const FrameEstimate a = without.process(omnislam::test::scan_from(walls, truth[i], rng_a), odometry[i]);
+    const FrameEstimate b = with.process(omnislam::test::scan_from(walls, truth[i], rng_b), odometry[i]);
+    REQUIRE(a.T_map_base.isApprox(b.T_map_base, 1e-12));
+    if (!a.integrated) continue;
+    CHECK(b.covariance.isApprox(a.covariance + with.map_uncertainty_at(b.T_map_base), 1e-9));
+  }
 }
 
 TEST_CASE("localization only without a map registers scan to scan and builds nothing", "[slam][resume]") {

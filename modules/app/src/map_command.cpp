@@ -101,13 +101,23 @@ void save(const std::filesystem::path &run_dir, const std::filesystem::path &fil
     }
   }
   s.map_integrations = static_cast<int>(s.counters.integrated);
-  for (const io::MapPointRecord &p : io::read_map_csv(run_dir / "map.csv")) {
-    s.points.push_back({{p.x_m, p.y_m}, p.hits, 0});
+  if (std::filesystem::exists(run_dir / "map.snapshot")) {
+    // The same map with its keyframe graph (replays write it): a run localized on it later
+    // knows how far the map may be off by place (the keyframes' covariances).
+    io::Snapshot with_graph = io::read_snapshot(run_dir / "map.snapshot");
+    s.map_integrations = with_graph.map_integrations;
+    s.points = std::move(with_graph.points);
+    s.graph = std::move(with_graph.graph);
+  } else {
+    for (const io::MapPointRecord &p : io::read_map_csv(run_dir / "map.csv")) {
+      s.points.push_back({{p.x_m, p.y_m}, p.hits, 0});
+    }
   }
   if (std::filesystem::exists(run_dir / "map.yaml")) s.grid = io::read_nav2_map(run_dir / "map.yaml");
   io::write_snapshot(file, s);
-  std::printf("saved %zu map points%s and the pose of frame %zu to %s\n", s.points.size(),
-              s.grid ? ", the occupancy grid" : "", trajectory.size(), file.c_str());
+  std::printf("saved %zu map points%s%s and the pose of frame %zu to %s\n", s.points.size(),
+              s.grid ? ", the occupancy grid" : "", s.graph ? ", the keyframe graph" : "", trajectory.size(),
+              file.c_str());
 }
 
 void load(const std::filesystem::path &file, const std::filesystem::path &out_dir) {

@@ -113,7 +113,8 @@ void run_replay(const ReplayOptions &options, std::optional<std::uint64_t> degra
   if (options.localize) {
     io::Snapshot snapshot = io::read_snapshot(options.map_file);
     run.localizing = true;
-    pipeline.relocalize(std::move(snapshot.points), snapshot.map_integrations);
+    pipeline.relocalize(std::move(snapshot.points), snapshot.map_integrations, {}, {},
+                        std::move(snapshot.graph));
   }
   pipeline.run(dataset_source(info, odometry, config.scan.camera, std::move(source_options)));
   if (!pipeline.error().empty()) throw std::runtime_error(pipeline.error());
@@ -133,6 +134,16 @@ void run_replay(const ReplayOptions &options, std::optional<std::uint64_t> degra
   const grid::GridImage grid_image = occupancy.image();
   if (grid_image.width > 0)
     io::write_nav2_map(std::filesystem::path(options.out_dir) / "map.yaml", grid_image);
+  // The map with the keyframe graph it was built from (its keyframes' covariances say how far
+  // it may be off by place), for `omnislam map save`: a replay's files do not hold the graph.
+  if (auto graph = pipeline.slam().graph_state(); graph && !run.localizing) {
+    io::Snapshot snapshot;
+    snapshot.points = pipeline.slam().map().points();
+    snapshot.map_integrations = pipeline.slam().map().integrations();
+    snapshot.graph = std::move(graph);
+    if (!pipeline.slam().trajectory().empty()) snapshot.T_map_base = pipeline.slam().trajectory().back();
+    io::write_snapshot(std::filesystem::path(options.out_dir) / "map.snapshot", snapshot);
+  }
 }
 
 }  // namespace

@@ -31,6 +31,7 @@ constexpr std::size_t kGridHeaderBytes = 4 + 4 + 8 + 8 + 8;  // version 3, when 
 // each counted item takes (a keyframe without scans, a scan without points, ...).
 constexpr std::size_t kGraphHeaderBytes = 8 + 3 * 8;
 constexpr std::size_t kKeyframeBytes = 4 * 8 + 8;
+constexpr std::size_t kKeyframeCovarianceBytes = 9 * 8;  // version 6
 constexpr std::size_t kScanBytes = 8;
 constexpr std::size_t kScanPointBytes = 8 + 8;
 constexpr std::size_t kIntegrationBytes = 4 + 4;
@@ -179,6 +180,8 @@ void encode_graph(ByteWriter &out, const std::optional<slam::KeyframeGraphState>
   for (const slam::KeyframeGraphState::SavedKeyframe &keyframe : graph->keyframes) {
     encode_pose(out, keyframe.T_map_keyframe);
     out.f64(keyframe.path_m);
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 3; ++c) out.f64(keyframe.covariance(r, c));
     out.u64(keyframe.scans_keyframe.size());
     for (const auto &scan : keyframe.scans_keyframe) {
       out.u64(scan->size());
@@ -232,11 +235,15 @@ int decode_index(ByteReader &in, const std::string &name, const std::string &wha
 }
 
 slam::KeyframeGraphState::SavedKeyframe decode_keyframe(ByteReader &in, const std::string &name,
-                                                        std::size_t k) {
+                                                        std::size_t k, bool with_covariance) {
   const std::string which = "keyframe " + std::to_string(k);
   slam::KeyframeGraphState::SavedKeyframe keyframe;
   keyframe.T_map_keyframe = decode_pose(in, which);
   keyframe.path_m = in.f64((which + " path_m").c_str());
+  if (with_covariance) {
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 3; ++c) keyframe.covariance(r, c) = in.f64((which + " covariance").c_str());
+  }
   const std::size_t scans = decode_count(in, name, "scans of " + which, kScanBytes);
   const std::string x_field = which + " scan point x_m", y_field = which + " scan point y_m";
   for (std::size_t i = 0; i < scans; ++i) {
@@ -270,7 +277,7 @@ slam::KeyframeGraphState::SavedEdge decode_edge(ByteReader &in, const std::strin
 // The version-4 graph section, checked as a whole once read (indices in range, every scan
 // integrated once, ...) and against the map it must describe.
 std::optional<slam::KeyframeGraphState> decode_graph(ByteReader &in, const std::string &name,
-                                                     int map_integrations) {
+                                                     int map_integrations, bool with_covariances) {
   const std::uint64_t has_graph = in.u64();
   if (has_graph > 1) throw SnapshotError(name + ": has_graph is " + std::to_string(has_graph));
   if (has_graph == 0) return std::nullopt;
@@ -278,8 +285,10 @@ std::optional<slam::KeyframeGraphState> decode_graph(ByteReader &in, const std::
   slam::KeyframeGraphState graph;
   graph.path_m = in.f64("keyframe graph path_m");
   graph.last_frame = decode_pose(in, "keyframe graph last frame");
-  const std::size_t keyframes = decode_count(in, name, "keyframes", kKeyframeBytes);
-  for (std::size_t k = 0; k < keyframes; ++k) graph.keyframes.push_back(decode_keyframe(in, name, k));
+  const std::size_t keyframes =
+      decode_count(in, name, "keyframes", kKeyframeBytes + (with_covariances ? kKeyframeCovarianceBytes : 0));
+  for (std::size_t k = 0; k < keyframes; ++k)
+    graph.keyframes.push_back(decode_keyframe(in, name, k, with_covariances));
   const std::size_t integrations = decode_count(in, name, "integrations", kIntegrationBytes);
   graph.integration_order.reserve(integrations);
   for (std::size_t i = 0; i < integrations; ++i) {
@@ -429,7 +438,7 @@ Snapshot decode_snapshot(std::span<const std::uint8_t> bytes, const std::string 
     s.points.push_back(p);
   }
   if (version >= 3) s.grid = decode_grid(in, name, version >= 4 ? 8 : 0, version >= 5);
-  if (version >= 4) s.graph = decode_graph(in, name, s.map_integrations);
+  if (version >= 4) s.graph = decode_graph(in, name, s.map_integrations, version >= 6);
   if (in.remaining() != 0) {
     throw SnapshotError(name + ": trailing bytes after the " +
                         (version >= 4 ? "keyframe graph" : "occupancy grid"));

@@ -1,6 +1,7 @@
 #include "omnislam/slam/keyframe_graph.hpp"
 
 #include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -54,6 +55,17 @@ bool usable_information(const Eigen::Matrix3d &information) {
   return Eigen::LLT<Eigen::Matrix3d>(information).info() == Eigen::Success;
 }
 
+// A covariance: finite, symmetric, no negative variance in any direction (zero is allowed:
+// the first keyframe defines the map frame).
+bool usable_covariance(const Eigen::Matrix3d &covariance) {
+  if (!covariance.allFinite()) return false;
+  const double scale = covariance.cwiseAbs().maxCoeff();
+  if ((covariance - covariance.transpose()).cwiseAbs().maxCoeff() > 1e-9 * scale) return false;
+  return Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(covariance, Eigen::EigenvaluesOnly)
+             .eigenvalues()
+             .minCoeff() >= -1e-9 * scale;
+}
+
 std::string keyframe_error(const KeyframeGraphState::SavedKeyframe &keyframe, std::size_t k,
                            double previous_path_m) {
   const std::string which = "keyframe " + std::to_string(k);
@@ -69,6 +81,8 @@ std::string keyframe_error(const KeyframeGraphState::SavedKeyframe &keyframe, st
     for (const Point2 &p : *scan)
       if (!p.allFinite()) return which + ": scan " + std::to_string(i) + " has a non-finite point";
   }
+  if (!usable_covariance(keyframe.covariance))
+    return which + ": covariance is not symmetric positive semi-definite";
   return {};
 }
 
@@ -133,7 +147,8 @@ KeyframeGraph::KeyframeGraph(KeyframeConfig config, const KeyframeGraphState &st
   if (std::string error = keyframe_graph_state_error(state); !error.empty())
     throw std::invalid_argument("keyframe graph state: " + error);
   for (const KeyframeGraphState::SavedKeyframe &saved : state.keyframes) {
-    keyframes_.push_back({isometry_of(saved.T_map_keyframe), saved.path_m, saved.scans_keyframe});
+    keyframes_.push_back(
+        {isometry_of(saved.T_map_keyframe), saved.path_m, saved.scans_keyframe, saved.covariance});
     graph_.add_node(keyframes_.back().T_map_keyframe);
   }
   for (const KeyframeGraphState::SavedEdge &edge : state.edges)
@@ -152,7 +167,8 @@ KeyframeGraph::KeyframeGraph(KeyframeConfig config, const KeyframeGraphState &st
 KeyframeGraphState KeyframeGraph::state() const {
   KeyframeGraphState state;
   for (const Keyframe &keyframe : keyframes_)
-    state.keyframes.push_back({planar_of(keyframe.T_map_keyframe), keyframe.path_m, keyframe.scans_keyframe});
+    state.keyframes.push_back(
+        {planar_of(keyframe.T_map_keyframe), keyframe.path_m, keyframe.scans_keyframe, keyframe.covariance});
   for (const PoseGraphEdge &edge : graph_.edges())
     state.edges.push_back({edge.from, edge.to, planar_of(edge.T_from_to), edge.information, edge.loop});
   state.integration_order = integration_order_;
@@ -164,6 +180,20 @@ KeyframeGraphState KeyframeGraph::state() const {
 KeyframeGraph::FrameAnchor KeyframeGraph::anchor(const Eigen::Isometry2d &T_map_base) const {
   if (anchor_ < 0) return {-1, T_map_base};
   return {anchor_, keyframes_[static_cast<std::size_t>(anchor_)].T_map_keyframe.inverse() * T_map_base};
+}
+
+void KeyframeGraph::add_scan_covariance(const Eigen::Matrix3d &covariance,
+                                        const Eigen::Isometry2d &T_map_base) {
+  if (integration_order_.empty()) return;
+  Keyframe &keyframe = keyframes_[static_cast<std::size_t>(integration_order_.back().first)];
+  // Carried from the frame to the keyframe (the frame's heading error swings its scan about
+  // the frame, not the keyframe), then into the running mean over the keyframe's scans.
+  const Eigen::Vector2d lever = keyframe.T_map_keyframe.translation() - T_map_base.translation();
+  Eigen::Matrix3d F = Eigen::Matrix3d::Identity();
+  F(0, 2) = -lever.y();
+  F(1, 2) = lever.x();
+  const double scans = static_cast<double>(keyframe.scans_keyframe.size());
+  keyframe.covariance += (F * covariance * F.transpose() - keyframe.covariance) / scans;
 }
 
 void KeyframeGraph::add_pose(const Eigen::Isometry2d &T_map_base) {

@@ -17,11 +17,11 @@
 /// Snapshots of the SLAM state (map, pose, counters, configuration hash) that a service
 /// writes periodically into its state directory and resumes from after a restart.
 ///
-/// File format, version 5 (all integers and doubles little-endian):
+/// File format, version 6 (all integers and doubles little-endian):
 /// ```
 /// offset  size  field
 ///  0       8    magic "OMNISNAP"
-///  8       4    u32 format version (5)
+///  8       4    u32 format version (6)
 /// 12       8    u64 payload size in bytes
 /// 20       4    u32 CRC-32 (zlib) of bytes 8..19 followed by the payload
 /// 24       -    payload: u64 config_hash, f64 t_s, f64 x_m, f64 y_m, f64 yaw_rad,
@@ -36,20 +36,23 @@
 ///               u64 has_graph (0 or 1), and when 1 the keyframe graph
 ///               (slam::KeyframeGraphState): f64 path_m, f64 last frame x_m, y_m, yaw_rad,
 ///               u64 keyframe count, per keyframe f64 x_m, f64 y_m, f64 yaw_rad, f64 path_m,
-///               u64 scan count, per scan u64 point count and per point f64 x_m, f64 y_m
-///               (keyframe coordinates); u64 integration count, per integration u32
-///               keyframe, u32 scan (within the keyframe); u64 edge count, per edge u32 from,
-///               u32 to, u64 loop (0 or 1), f64 x_m, f64 y_m, f64 yaw_rad (pose of `to` in
+///               9 x f64 covariance (row-major, x y yaw; slam::Keyframe::covariance), u64 scan count, per
+///               scan u64 point count and per point f64 x_m, f64 y_m (keyframe coordinates); u64 integration
+///               count, per integration u32 keyframe, u32 scan (within the keyframe); u64 edge count, per
+///               edge u32 from, u32 to, u64 loop (0 or 1), f64 x_m, f64 y_m, f64 yaw_rad (pose of `to` in
 ///               `from`), 9 x f64 information (row-major, x y yaw)
 /// ```
-/// Version 4 is version 5 without the grid's above-floor flags, version 3 version 4 without
+/// Version 5 is version 6 without the keyframes' covariances, version 4 version 5 without the
+/// grid's above-floor flags, version 3 version 4 without
 /// the graph section, version 2 version 3 without the grid section, version 1 version 2
-/// without the four odometry fields; all are still read (their grid's `above_floor`, before
+/// without the four odometry fields; all are still read (their keyframes' covariances are
+/// zero: a run localized on such a map publishes its registrations' alone; before version 5
+/// their grid's `above_floor`, before
 /// version 4 their `graph`, and before version 3 their `grid`, are empty).
 
 namespace omnislam::io {
 
-inline constexpr std::uint32_t kSnapshotVersion = 5;
+inline constexpr std::uint32_t kSnapshotVersion = 6;
 
 /// A snapshot that cannot be used: missing, truncated, of another version, failing its
 /// checksum, or holding impossible values. The message names the file.

@@ -51,6 +51,13 @@ struct Keyframe {
   /// The integrated scans it holds, keyframe coordinates; immutable once stored, shared by
   /// every copy of the graph.
   std::vector<std::shared_ptr<const Points2>> scans_keyframe;
+  /// How far its scans may lie from where the map puts them: the mean of the (x, y, yaw)
+  /// covariances (map frame, carried to this keyframe's pose) that the run published for the
+  /// frames whose scans it holds (the keyframe's own, the frames that joined it, revisits,
+  /// each placed by its own tracking). A run localized on this map later adds it to its own
+  /// (Slam, localization_only); a loop closure that moves the keyframe since leaves it as it
+  /// was, on the safe side.
+  Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
 };
 
 /// A planar pose as three numbers, so that a saved graph reads back bit for bit.
@@ -70,6 +77,7 @@ struct KeyframeGraphState {
     PlanarPose T_map_keyframe;
     double path_m = 0.0;
     std::vector<std::shared_ptr<const Points2>> scans_keyframe;  ///< keyframe coordinates
+    Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();        ///< Keyframe::covariance
   };
   struct SavedEdge {
     int from = 0;
@@ -91,7 +99,8 @@ struct KeyframeGraphState {
 /// What makes `state` unusable as a KeyframeGraph, or an empty string: non-finite values,
 /// negative or decreasing path lengths, a null scan, edge nodes out of range or equal, an
 /// information matrix that is not symmetric positive definite, an integration order that
-/// does not name every stored scan exactly once.
+/// does not name every stored scan exactly once, a keyframe covariance that is not symmetric
+/// positive semi-definite.
 [[nodiscard]] std::string keyframe_graph_state_error(const KeyframeGraphState &state);
 
 /// A stored scan and the pose it is integrated at.
@@ -120,6 +129,10 @@ class KeyframeGraph {
   /// that keyframe) plus the floor. Returns whether it did.
   bool add_integrated(const Points2 &scan_base, const Eigen::Isometry2d &T_map_base,
                       const Eigen::Matrix3d &tracked_covariance);
+  /// Counts the published covariance of the frame whose scan was stored last (at
+  /// `T_map_base`, map frame) into the covariance of the keyframe that holds the scan
+  /// (Keyframe::covariance, a mean over its scans). Nothing when no scan is stored.
+  void add_scan_covariance(const Eigen::Matrix3d &covariance, const Eigen::Isometry2d &T_map_base);
   /// Records a frame that was not integrated (only its pose, relative to the keyframe the
   /// frames are anchored to: the last one, or the one revisited).
   void add_pose(const Eigen::Isometry2d &T_map_base);

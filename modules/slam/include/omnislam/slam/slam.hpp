@@ -188,10 +188,19 @@ class Slam {
   /// integrations as `integrations`, else std::invalid_argument) and loop closure on, the
   /// graph continues: new keyframes join it, loop closure can close loops against the saved
   /// keyframes, and a loop's rebuilt map is made from all of them. Without one, the restored
-  /// points are a fixed base that the graph of the new keyframes is added to.
+  /// points are a fixed base that the graph of the new keyframes is added to. On a fixed map
+  /// (localization_only) the graph's keyframe covariances say how far the map may be off
+  /// where the robot is, and every published covariance adds the nearest's (map_uncertainty_at).
   void resume(std::vector<MapPoint> points, int integrations, const Eigen::Isometry2d &T_map_base,
               const Eigen::Matrix3d &covariance, const std::optional<Eigen::Isometry2d> &T_odom_base = {},
               std::optional<ResumedGraph> graph = {});
+
+  /// How far the saved map may lie from the truth at `T_map_base`, as a covariance of a pose
+  /// registered on it there: the mean covariance of the saved keyframes within
+  /// keyframe_distance_m (else of the nearest one), each carried to `T_map_base` (a
+  /// keyframe's heading error swings the map by the lever arm). Zero without a saved
+  /// graph, or with one from a snapshot older than version 6 (which carries no covariances).
+  [[nodiscard]] Eigen::Matrix3d map_uncertainty_at(const Eigen::Isometry2d &T_map_base) const;
 
   /// The keyframe graph to save with the map, when it describes the map (every map
   /// integration is one of its scans): not with loop closure off, nor after a resume
@@ -427,6 +436,8 @@ class Slam {
   /// The published walk when the doubt began: a pose found on the map inherits it.
   Eigen::Matrix3d walk_before_lost_ = Eigen::Matrix3d::Zero();
   double walk_dof_before_lost_ = std::numeric_limits<double>::infinity();
+  /// The resumed graph's keyframes (pose, covariance): the saved map's uncertainty by place.
+  std::vector<std::pair<Eigen::Isometry2d, Eigen::Matrix3d>> saved_places_;
 };
 
 }  // namespace omnislam::slam
