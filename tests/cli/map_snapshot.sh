@@ -30,6 +30,8 @@ grep -q "^occupancy grid: ${width_height/ / x } cells at 0.050 m" "$work/info.tx
 # The replay's map.snapshot gives the snapshot its keyframe graph (one scan per frame here).
 grep -Eq "^keyframe graph: [0-9]+ keyframes, [0-9]+ edges \(0 loop\), [0-9]+ integrated scans, path [0-9.]+ m$" "$work/info.txt" ||
   fail "info: no keyframe graph from the replay's map.snapshot: $(grep graph "$work/info.txt")"
+grep -Eq "^map uncertainty \(keyframes, 1 sigma, min / median / max\): position [0-9.]+ / [0-9.]+ / [0-9.]+ mm, heading [0-9.]+ / [0-9.]+ / [0-9.]+ deg$" "$work/info.txt" ||
+  fail "info: no map uncertainty line: $(grep uncertainty "$work/info.txt")"
 cmp <("$omnislam" map info "$work/run/map.snapshot" | grep "^keyframe graph") <(grep "^keyframe graph" "$work/info.txt") ||
   fail "info: the saved keyframe graph is not the replay's"
 # Without it (an older replay's output) the snapshot holds none.

@@ -1,7 +1,9 @@
 #include "map_command.hpp"
 #include "omnislam/slam/planar_pose.hpp"
 
+#include <Eigen/Eigenvalues>
 #include <algorithm>
+#include <array>
 #include <cinttypes>
 #include <cmath>
 #include <cstdio>
@@ -12,6 +14,7 @@
 #include <nlohmann/json.hpp>
 #include <numbers>
 #include <string>
+#include <vector>
 
 #include "omnislam/grid/occupancy_grid.hpp"
 #include "omnislam/io/grid_files.hpp"
@@ -21,6 +24,32 @@
 
 namespace omnislam::app {
 namespace {
+
+// How far the map may be off by place (its keyframes' covariances, version 6): the spread of
+// their position and heading standard deviations (the position's along its worst direction).
+void print_map_uncertainty(const slam::KeyframeGraphState &graph, std::uint32_t version) {
+  if (version < 6 || graph.keyframes.empty()) {
+    std::printf("map uncertainty: unknown (snapshot version %u keeps no keyframe covariances)\n", version);
+    return;
+  }
+  std::vector<double> position_mm, heading_deg;
+  for (const slam::KeyframeGraphState::SavedKeyframe &keyframe : graph.keyframes) {
+    const Eigen::Matrix2d position = keyframe.covariance.topLeftCorner<2, 2>();
+    const double worst = Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(position).eigenvalues().maxCoeff();
+    position_mm.push_back(1000.0 * std::sqrt(std::max(0.0, worst)));
+    heading_deg.push_back(std::sqrt(std::max(0.0, keyframe.covariance(2, 2))) * 180.0 / std::numbers::pi);
+  }
+  const auto spread = [](std::vector<double> &values) {
+    std::sort(values.begin(), values.end());
+    return std::array<double, 3>{values.front(), values[values.size() / 2], values.back()};
+  };
+  const auto [p_min, p_median, p_max] = spread(position_mm);
+  const auto [h_min, h_median, h_max] = spread(heading_deg);
+  std::printf(
+      "map uncertainty (keyframes, 1 sigma, min / median / max): position %.1f / %.1f / %.1f mm, "
+      "heading %.3f / %.3f / %.3f deg\n",
+      p_min, p_median, p_max, h_min, h_median, h_max);
+}
 
 void print_info(const std::filesystem::path &file) {
   const io::Snapshot s = io::read_snapshot(file);
@@ -59,6 +88,7 @@ void print_info(const std::filesystem::path &file) {
     std::printf("keyframe graph: %zu keyframes, %zu edges (%td loop), %zu integrated scans, path %.2f m\n",
                 s.graph->keyframes.size(), s.graph->edges.size(), loops, s.graph->integrations(),
                 s.graph->path_m);
+    print_map_uncertainty(*s.graph, s.version);
   } else {
     std::printf("keyframe graph: none\n");
   }
