@@ -73,7 +73,6 @@ Pipeline::Pipeline(const stereo::ScanConfig &scan, const slam::SlamConfig &slam,
       config_(config),
       sinks_(std::move(sinks)),
       slam_(with_loop_closure_thread(slam, config)),
-      slam_localization_only_(slam.localization_only),
       queues_{Queue(config.queue_capacity), Queue(config.queue_capacity), Queue(config.queue_capacity),
               Queue(config.queue_capacity)} {}
 
@@ -298,8 +297,9 @@ void Pipeline::relocalize_frame(Frame &frame, const std::optional<Eigen::Isometr
   if (saved_graph_) graph = slam::ResumedGraph{std::move(*saved_graph_), false};
   slam_.resume(std::move(saved_points_), saved_integrations_, found.T_map_base, found.covariance, T_odom_base,
                std::move(graph));
-  // On a fixed map the pose is as uncertain as the map is there, too (Slam::map_uncertainty_at).
-  if (slam_localization_only_) frame.estimate.covariance += slam_.map_uncertainty_at(found.T_map_base);
+  // The pose found on the saved map is as uncertain as the map is there, too
+  // (Slam::map_uncertainty_at; Slam::resume starts its walk from the same).
+  frame.estimate.covariance += slam_.map_uncertainty_at(found.T_map_base);
   relocalizer_.reset();
 }
 

@@ -202,6 +202,8 @@ void Slam::resume(std::vector<MapPoint> points, int integrations, const Eigen::I
                   std::optional<ResumedGraph> graph) {
   // Checked before anything changes: a graph that is not the map's leaves this as it was.
   const bool continue_graph = config_.loop_closure.enabled && graph;
+  KeyframeGraph keyframes =
+      continue_graph ? resumed_graph(*graph, integrations) : KeyframeGraph(config_.loop_closure.keyframes);
   saved_places_.clear();
   if (graph) {
     for (const KeyframeGraphState::SavedKeyframe &keyframe : graph->state.keyframes)
@@ -209,8 +211,6 @@ void Slam::resume(std::vector<MapPoint> points, int integrations, const Eigen::I
                                              keyframe.T_map_keyframe.yaw_rad),
                                  keyframe.covariance);
   }
-  KeyframeGraph keyframes =
-      continue_graph ? resumed_graph(*graph, integrations) : KeyframeGraph(config_.loop_closure.keyframes);
   // With the saved graph the restored points are its scans, which a rebuild integrates
   // itself; without it they are a base the graph's corrections do not move.
   restored_points_.reset();
@@ -232,8 +232,12 @@ void Slam::resume(std::vector<MapPoint> points, int integrations, const Eigen::I
   started_ = true;
   anchor_T_odom_base_ = T_odom_base;
   anchor_T_map_base_ = T_map_base;
-  previous_ = {T_map_base, true, Attempt::kNone, {}, covariance};
-  walk_covariance_ = covariance;
+  // A pose found afresh on the saved map (the graph not chained to it) is as uncertain as the
+  // map is there, too; a saved pose taken as is carries its own run's covariance already.
+  const Eigen::Matrix3d start =
+      graph && !graph->chained ? Eigen::Matrix3d(covariance + map_uncertainty_at(T_map_base)) : covariance;
+  previous_ = {T_map_base, true, Attempt::kNone, {}, start};
+  walk_covariance_ = start;
   walk_dof_ = std::numeric_limits<double>::infinity();
   since_keyframe_covariance_.setZero();  // the saved pose is taken as is
   anchor_walks_at(T_map_base);

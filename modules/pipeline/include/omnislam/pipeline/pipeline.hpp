@@ -155,7 +155,6 @@ class Pipeline {
   PipelineConfig config_;
   Sinks sinks_;
   slam::Slam slam_;
-  bool slam_localization_only_ = false;  ///< slam::SlamConfig::localization_only
   /// While relocalising: the search, the saved map it hands to slam_, and the search window.
   std::unique_ptr<slam::Relocalizer> relocalizer_;
   slam::RelocalizerConfig relocalizer_config_;
