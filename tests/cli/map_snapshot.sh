@@ -34,6 +34,12 @@ grep -Eq "^map uncertainty \(keyframes, 1 sigma, min / median / max\): position 
   fail "info: no map uncertainty line: $(grep uncertainty "$work/info.txt")"
 cmp <("$omnislam" map info "$work/run/map.snapshot" | grep "^keyframe graph") <(grep "^keyframe graph" "$work/info.txt") ||
   fail "info: the saved keyframe graph is not the replay's"
+# A replay without loop closure keeps no graph, and leaves no earlier run's map.snapshot behind.
+printf 'slam: {loop_closure: {enabled: false}}\n' >"$work/no-loops.yaml"
+"$omnislam" replay "$dataset" --out "$work/rerun" >/dev/null 2>&1
+[ -e "$work/rerun/map.snapshot" ] || fail "a replay with loop closure wrote no map.snapshot"
+"$omnislam" replay "$dataset" --out "$work/rerun" --config "$work/no-loops.yaml" >/dev/null 2>&1
+[ ! -e "$work/rerun/map.snapshot" ] || fail "a replay without loop closure left the earlier run's map.snapshot"
 # Without it (an older replay's output) the snapshot holds none.
 mkdir -p "$work/old-run"
 cp "$work/run/"{trajectory.tum,covariance.csv,summary.json,map.csv,map.yaml,map.pgm} "$work/old-run/"

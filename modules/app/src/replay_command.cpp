@@ -136,13 +136,16 @@ void run_replay(const ReplayOptions &options, std::optional<std::uint64_t> degra
     io::write_nav2_map(std::filesystem::path(options.out_dir) / "map.yaml", grid_image);
   // The map with the keyframe graph it was built from (its keyframes' covariances say how far
   // it may be off by place), for `omnislam map save`: a replay's files do not hold the graph.
-  if (auto graph = pipeline.slam().graph_state(); graph && !run.localizing) {
+  const std::filesystem::path snapshot_file = std::filesystem::path(options.out_dir) / "map.snapshot";
+  if (auto graph = pipeline.slam().graph_state(); !graph || run.localizing) {
+    std::filesystem::remove(snapshot_file);  // an earlier run's, into the same directory
+  } else {
     io::Snapshot snapshot;
     snapshot.points = pipeline.slam().map().points();
     snapshot.map_integrations = pipeline.slam().map().integrations();
     snapshot.graph = std::move(graph);
     if (!pipeline.slam().trajectory().empty()) snapshot.T_map_base = pipeline.slam().trajectory().back();
-    io::write_snapshot(std::filesystem::path(options.out_dir) / "map.snapshot", snapshot);
+    io::write_snapshot(snapshot_file, snapshot);
   }
 }
 
