@@ -77,9 +77,9 @@ Eigen::Matrix3d Slam::published_covariance(const FrameEstimate &estimate, const 
   // within 3% of the walk after ten.
   //
   // On a fixed map the pose is the registration's on a map that is itself off by as much as
-  // the poses it was built from were: the saved keyframe's covariance where the robot is is
-  // added (map_uncertainty_at; measured 2026-12-07, mean NEES on six bundled datasets'
-  // own saved maps 138-169,950 without it, 0.9-4.4 with the nearest frame's).
+  // the poses it was built from were: the saved keyframes' covariance where the robot is is
+  // added (map_uncertainty_at; measured 2026-12-07, mean NEES of each bundled dataset
+  // localized on its own saved map 138-169,950 without it, 0.8-3.7 with it).
   const TrimmedIcpResult &registration = estimate.registration;
   if (estimate.integrated && config_.localization_only) {
     walk_covariance_ = registration.robust_covariance;
