@@ -82,6 +82,19 @@ def start(config: Path, env_extra: dict[str, str] | None = None) -> subprocess.P
                             stderr=subprocess.STDOUT, text=True, env=env)
 
 
+def saved_state(tmp_path: Path, dataset: Path) -> tuple[Path, Path]:
+    """A state directory holding the snapshot of a replay of `dataset` (`map save`), and the
+    replay's output directory."""
+    state = tmp_path / "state"
+    state.mkdir()
+    mapping = tmp_path / "mapping"
+    subprocess.run([os.environ["OMNISLAM_BIN"], "replay", str(dataset), "--out", str(mapping)], check=True,
+                   capture_output=True)
+    subprocess.run([os.environ["OMNISLAM_BIN"], "map", "save", str(mapping), str(state / "state.omnisnap")],
+                   check=True, capture_output=True)
+    return state, mapping
+
+
 def map_info(snapshot: Path) -> str:
     return subprocess.run([os.environ["OMNISLAM_BIN"], "map", "info", str(snapshot)], check=True,
                           capture_output=True, text=True).stdout
@@ -285,13 +298,7 @@ def test_localization_only_finds_its_pose_on_the_saved_map(tmp_path):
     """With slam.localization_only the saved pose is not trusted (persistence.start_pose auto):
     the service searches the saved map, publishes nothing until one pose is confirmed, then
     tracks in the saved map's frame without changing the map."""
-    state = tmp_path / "state"
-    state.mkdir()
-    mapping = tmp_path / "mapping"
-    subprocess.run([os.environ["OMNISLAM_BIN"], "replay", str(DATASET), "--out", str(mapping)], check=True,
-                   capture_output=True)
-    subprocess.run([os.environ["OMNISLAM_BIN"], "map", "save", str(mapping), str(state / "state.omnisnap")],
-                   check=True, capture_output=True)
+    state, mapping = saved_state(tmp_path, DATASET)
     out = tmp_path / "out"
     service = start(write_config(tmp_path / "c.yaml", state=state, out=out, rate_hz=0,
                                  extra="slam: {localization_only: true}\n"))
@@ -317,13 +324,7 @@ def test_start_pose_search_maps_on_from_the_found_pose_with_the_maps_uncertainty
     search's plus how far the saved map may be off there (its keyframes' covariances).
     Measured mean NEES 3.1, 100% inside the 95% ellipse (7.2 and 94.3% when the walk started
     from the search's covariance alone)."""
-    state = tmp_path / "state"
-    state.mkdir()
-    mapping = tmp_path / "mapping"
-    subprocess.run([os.environ["OMNISLAM_BIN"], "replay", str(DATASET), "--out", str(mapping)], check=True,
-                   capture_output=True)
-    subprocess.run([os.environ["OMNISLAM_BIN"], "map", "save", str(mapping), str(state / "state.omnisnap")],
-                   check=True, capture_output=True)
+    state, _ = saved_state(tmp_path, DATASET)
     out = tmp_path / "out"
     config = write_config(tmp_path / "c.yaml", out=out, rate_hz=0)
     config.write_text(config.read_text() +
@@ -339,14 +340,7 @@ def test_start_pose_search_maps_on_from_the_found_pose_with_the_maps_uncertainty
 
 
 def test_start_pose_search_on_another_rooms_map_publishes_nothing(tmp_path):
-    state = tmp_path / "state"
-    state.mkdir()
-    mapping = tmp_path / "mapping"
-    office = REPO / "datasets" / "office-real"
-    subprocess.run([os.environ["OMNISLAM_BIN"], "replay", str(office), "--out", str(mapping)], check=True,
-                   capture_output=True)
-    subprocess.run([os.environ["OMNISLAM_BIN"], "map", "save", str(mapping), str(state / "state.omnisnap")],
-                   check=True, capture_output=True)
+    state, _ = saved_state(tmp_path, REPO / "datasets" / "office-real")
     before = (state / "state.omnisnap").read_bytes()
     out = tmp_path / "out"
     config = tmp_path / "search.yaml"

@@ -170,6 +170,12 @@ void encode_pose(ByteWriter &out, const slam::PlanarPose &pose) {
   out.f64(pose.yaw_rad);
 }
 
+// An (x, y, yaw) covariance or information matrix, 9 f64 row-major.
+void encode_matrix(ByteWriter &out, const Eigen::Matrix3d &m) {
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) out.f64(m(r, c));
+}
+
 // The version-4 graph section: u64 has_graph, then (when 1) the keyframe graph.
 void encode_graph(ByteWriter &out, const std::optional<slam::KeyframeGraphState> &graph) {
   out.u64(graph ? 1 : 0);
@@ -180,8 +186,7 @@ void encode_graph(ByteWriter &out, const std::optional<slam::KeyframeGraphState>
   for (const slam::KeyframeGraphState::SavedKeyframe &keyframe : graph->keyframes) {
     encode_pose(out, keyframe.T_map_keyframe);
     out.f64(keyframe.path_m);
-    for (int r = 0; r < 3; ++r)
-      for (int c = 0; c < 3; ++c) out.f64(keyframe.covariance(r, c));
+    encode_matrix(out, keyframe.covariance);
     out.u64(keyframe.scans_keyframe.size());
     for (const auto &scan : keyframe.scans_keyframe) {
       out.u64(scan->size());
@@ -202,8 +207,7 @@ void encode_graph(ByteWriter &out, const std::optional<slam::KeyframeGraphState>
     out.u32(static_cast<std::uint32_t>(edge.to));
     out.u64(edge.loop ? 1 : 0);
     encode_pose(out, edge.T_from_to);
-    for (int r = 0; r < 3; ++r)
-      for (int c = 0; c < 3; ++c) out.f64(edge.information(r, c));
+    encode_matrix(out, edge.information);
   }
 }
 
@@ -213,6 +217,13 @@ slam::PlanarPose decode_pose(ByteReader &in, const std::string &what) {
   pose.y_m = in.f64((what + " y_m").c_str());
   pose.yaw_rad = in.f64((what + " yaw_rad").c_str());
   return pose;
+}
+
+Eigen::Matrix3d decode_matrix(ByteReader &in, const std::string &what) {
+  Eigen::Matrix3d m;
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) m(r, c) = in.f64(what.c_str());
+  return m;
 }
 
 // A count of items of at least `item_bytes` each, checked against what is left before
@@ -240,10 +251,7 @@ slam::KeyframeGraphState::SavedKeyframe decode_keyframe(ByteReader &in, const st
   slam::KeyframeGraphState::SavedKeyframe keyframe;
   keyframe.T_map_keyframe = decode_pose(in, which);
   keyframe.path_m = in.f64((which + " path_m").c_str());
-  if (with_covariance) {
-    for (int r = 0; r < 3; ++r)
-      for (int c = 0; c < 3; ++c) keyframe.covariance(r, c) = in.f64((which + " covariance").c_str());
-  }
+  if (with_covariance) keyframe.covariance = decode_matrix(in, which + " covariance");
   const std::size_t scans = decode_count(in, name, "scans of " + which, kScanBytes);
   const std::string x_field = which + " scan point x_m", y_field = which + " scan point y_m";
   for (std::size_t i = 0; i < scans; ++i) {
@@ -269,8 +277,7 @@ slam::KeyframeGraphState::SavedEdge decode_edge(ByteReader &in, const std::strin
   if (loop > 1) throw SnapshotError(name + ": keyframe graph " + which + " loop is " + std::to_string(loop));
   edge.loop = loop == 1;
   edge.T_from_to = decode_pose(in, which);
-  for (int r = 0; r < 3; ++r)
-    for (int c = 0; c < 3; ++c) edge.information(r, c) = in.f64((which + " information").c_str());
+  edge.information = decode_matrix(in, which + " information");
   return edge;
 }
 
@@ -317,8 +324,7 @@ std::vector<std::uint8_t> encode_snapshot(const Snapshot &snapshot) {
   payload.f64(t.x());
   payload.f64(t.y());
   payload.f64(slam::yaw_rad_of(snapshot.T_map_base));
-  for (int r = 0; r < 3; ++r)
-    for (int c = 0; c < 3; ++c) payload.f64(snapshot.covariance(r, c));
+  encode_matrix(payload, snapshot.covariance);
   const SnapshotCounters &n = snapshot.counters;
   for (std::uint64_t count : {n.frames, n.integrated, n.not_integrated, n.skipped, n.dropped})
     payload.u64(count);
@@ -394,8 +400,7 @@ Snapshot decode_snapshot(std::span<const std::uint8_t> bytes, const std::string 
   s.t_s = in.f64("t_s");
   const double x = in.f64("x_m"), y = in.f64("y_m"), yaw = in.f64("yaw_rad");
   s.T_map_base = slam::planar_pose(x, y, yaw);
-  for (int r = 0; r < 3; ++r)
-    for (int c = 0; c < 3; ++c) s.covariance(r, c) = in.f64("covariance");
+  s.covariance = decode_matrix(in, "covariance");
   SnapshotCounters &n = s.counters;
   for (std::uint64_t *count : {&n.frames, &n.integrated, &n.not_integrated, &n.skipped, &n.dropped})
     *count = in.u64();

@@ -188,12 +188,9 @@ void KeyframeGraph::add_scan_covariance(const Eigen::Matrix3d &covariance,
   Keyframe &keyframe = keyframes_[static_cast<std::size_t>(integration_order_.back().first)];
   // Carried from the frame to the keyframe (the frame's heading error swings its scan about
   // the frame, not the keyframe), then into the running mean over the keyframe's scans.
-  const Eigen::Vector2d lever = keyframe.T_map_keyframe.translation() - T_map_base.translation();
-  Eigen::Matrix3d F = Eigen::Matrix3d::Identity();
-  F(0, 2) = -lever.y();
-  F(1, 2) = lever.x();
   const double scans = static_cast<double>(keyframe.scans_keyframe.size());
-  keyframe.covariance += (F * covariance * F.transpose() - keyframe.covariance) / scans;
+  keyframe.covariance +=
+      (carried(covariance, T_map_base, keyframe.T_map_keyframe) - keyframe.covariance) / scans;
 }
 
 void KeyframeGraph::add_pose(const Eigen::Isometry2d &T_map_base) {

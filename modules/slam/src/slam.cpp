@@ -32,17 +32,6 @@ Eigen::Matrix3d odometry_step_covariance(const Eigen::Isometry2d &step) {
   return Eigen::Vector3d(sigma_xy * sigma_xy, sigma_xy * sigma_xy, sigma_yaw * sigma_yaw).asDiagonal();
 }
 
-// A pose covariance (x, y, yaw in the map frame) carried from pose `from` to pose `to` by a
-// motion taken as exact: the heading's error swings the position by the lever arm.
-Eigen::Matrix3d carried(const Eigen::Matrix3d &covariance, const Eigen::Isometry2d &from,
-                        const Eigen::Isometry2d &to) {
-  const Eigen::Vector2d lever = to.translation() - from.translation();
-  Eigen::Matrix3d F = Eigen::Matrix3d::Identity();
-  F(0, 2) = -lever.y();
-  F(1, 2) = lever.x();
-  return F * covariance * F.transpose();
-}
-
 // A covariance's size for Welch-Satterthwaite: its position variance.
 double position_size(const Eigen::Matrix3d &covariance) { return covariance.topLeftCorner<2, 2>().trace(); }
 

@@ -49,4 +49,15 @@ namespace omnislam::slam {
   return rotate * covariance * rotate.transpose();
 }
 
+/// A pose covariance (x, y, yaw in the map frame) carried from pose `from` to pose `to` by a
+/// motion taken as exact: the heading's error swings the position by the lever arm.
+[[nodiscard]] inline Eigen::Matrix3d carried(const Eigen::Matrix3d &covariance, const Eigen::Isometry2d &from,
+                                             const Eigen::Isometry2d &to) {
+  const Eigen::Vector2d lever = to.translation() - from.translation();
+  Eigen::Matrix3d F = Eigen::Matrix3d::Identity();
+  F(0, 2) = -lever.y();
+  F(1, 2) = lever.x();
+  return F * covariance * F.transpose();
+}
+
 }  // namespace omnislam::slam
