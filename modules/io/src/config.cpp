@@ -289,6 +289,19 @@ void read_slam(YamlSection &section, slam::SlamConfig &slam) {
   section.read("lost_after_frames", slam.lost_after_frames);
   detail::read_section(section, "loop_closure",
                        [&slam](YamlSection &loops) { read_loop_closure(loops, slam.loop_closure); });
+  detail::read_section(section, "odometry_scale", [&slam](YamlSection &scale) {
+    slam::OdometryScaleConfig &config = slam.odometry_scale;
+    scale.read("enabled", config.enabled);
+    scale.read("prior_sigma", config.prior_sigma);
+    scale.read("significance_sigmas", config.significance_sigmas);
+    scale.read("outlier_sigmas", config.outlier_sigmas);
+    if (!(config.prior_sigma > 0.0 && config.prior_sigma <= 1.0))
+      scale.fail("prior_sigma", "must be in (0, 1]");
+    if (!(config.significance_sigmas >= 0.0 && std::isfinite(config.significance_sigmas)))
+      scale.fail("significance_sigmas", "must be >= 0 (0: the factor applied as soon as it differs from 1)");
+    if (!(config.outlier_sigmas > 0.0 && std::isfinite(config.outlier_sigmas)))
+      scale.fail("outlier_sigmas", "must be positive");
+  });
   if (!(slam.icp.overlap > 0.0 && slam.icp.overlap <= 1.0)) section.fail("overlap", "must be in (0, 1]");
   if (!(slam.icp.initial_search_radius_m > 0.0)) section.fail("initial_search_radius_m", "must be positive");
   if (slam.icp.covariance_sectors < 1 || slam.icp.covariance_sectors > 360)

@@ -221,6 +221,7 @@ void Slam::resume(std::vector<MapPoint> points, int integrations, const Eigen::I
   started_ = true;
   anchor_T_odom_base_ = T_odom_base;
   anchor_T_map_base_ = T_map_base;
+  odometry_scale_.break_chain();
   // A pose found afresh on the saved map (the graph not chained to it) is as uncertain as the
   // map is there, too; a saved pose taken as is carries its own run's covariance already.
   const Eigen::Matrix3d start =
@@ -306,6 +307,7 @@ void Slam::set_pose(const Eigen::Isometry2d &T_map_base, const Eigen::Matrix3d &
   relocalizer_.reset();
   lost_ = false;
   unplaced_.clear();  // their poses stay dead-reckoned: the operator's pose is too rough to place them back
+  odometry_scale_.break_chain();  // what the factor learnt stays: the same wheels
 }
 
 void Slam::anchor_walks_at(const Eigen::Isometry2d &T_map_base) {
@@ -444,16 +446,23 @@ FrameEstimate Slam::process(const Points2 &scan_base, const std::optional<Eigen:
   // Without odometry the robot is predicted to keep the last frame-to-frame motion.
   Eigen::Isometry2d step = Eigen::Isometry2d::Identity();
   Eigen::Isometry2d from = previous_.T_map_base;
+  Eigen::Matrix3d scale_covariance = Eigen::Matrix3d::Zero();
   if (config_.use_odometry) {
     if (!T_odom_base) {
       step = last_step_;
     } else if (anchor_T_odom_base_) {
       step = anchor_T_odom_base_->inverse() * *T_odom_base;
       from = anchor_T_map_base_;
+      // The odometry's distance read with the factor learnt so far, and that factor's own
+      // uncertainty along the step (map frame).
+      const Eigen::Vector2d along = from.linear() * step.translation();
+      const double sigma = odometry_scale_.applied_sigma();
+      scale_covariance.topLeftCorner<2, 2>() = sigma * sigma * along * along.transpose();
+      step.translation() *= odometry_scale_.applied();
     }
   }
   const Eigen::Isometry2d predicted = from * step;
-  prediction_covariance_ = uncommitted_covariance_ + odometry_step_covariance(step);
+  prediction_covariance_ = uncommitted_covariance_ + odometry_step_covariance(step) + scale_covariance;
   // In an odometry gap the motion is a guess (the last one kept up): neither a prior nor a
   // reason to reject a correction.
   predicted_by_odometry_ = config_.use_odometry && T_odom_base.has_value();
@@ -754,6 +763,28 @@ FrameEstimate Slam::found_again(const Points2 &scan_base, const std::optional<Ei
   return estimate;
 }
 
+void Slam::learn_odometry_scale(const FrameEstimate &estimate,
+                                const std::optional<Eigen::Isometry2d> &T_odom_base) {
+  if (!config_.odometry_scale.enabled || !config_.use_odometry || !config_.odometry_prior) return;
+  // A gap, a lost or carried robot, a pose found by the search, or a loop closure that moved
+  // the poses: the odometry since the last pinned frame no longer joins two comparable poses.
+  if (!T_odom_base || !predicted_by_odometry_ || estimate.lost || estimate.unfit || estimate.relocalized ||
+      estimate.loop_closed) {
+    odometry_scale_.break_chain();
+    return;
+  }
+  const Eigen::Isometry2d raw_step = anchor_T_odom_base_
+                                         ? Eigen::Isometry2d(anchor_T_odom_base_->inverse() * *T_odom_base)
+                                         : Eigen::Isometry2d::Identity();
+  odometry_scale_.add_step(*T_odom_base, odometry_step_covariance(raw_step).topLeftCorner<2, 2>());
+  // Pinned: placed on the map by its scan in both directions (where the pairs leave one to
+  // the prior, along a corridor, the position is the odometry's own and measures nothing).
+  const TrimmedIcpResult &registration = estimate.registration;
+  if (estimate.integrated && estimate.attempt == Attempt::kMap && registration.unconstrained_directions == 0)
+    odometry_scale_.pin(*T_odom_base, estimate.T_map_base,
+                        predictive_covariance(registration).topLeftCorner<2, 2>());
+}
+
 FrameEstimate Slam::finish_frame(FrameEstimate estimate, const Points2 &scan_base,
                                  const std::optional<Eigen::Isometry2d> &T_odom_base, bool in_graph) {
   if (!in_graph) keyframes_.add_pose(estimate.T_map_base);
@@ -768,6 +799,7 @@ FrameEstimate Slam::finish_frame(FrameEstimate estimate, const Points2 &scan_bas
   estimate.map_rebuilt = estimate.map_rebuilt || rebuilt_since_frame_;
   closed_since_frame_ = rebuilt_since_frame_ = false;
   previous_failed_ = !estimate.integrated;
+  learn_odometry_scale(estimate, T_odom_base);
   if (T_odom_base) set_anchor(*T_odom_base, estimate.T_map_base);
   // Extrapolated through gaps, re-made a rotation: the inverse transposes (planar_pose.hpp).
   last_step_ = orthonormalized(previous_.T_map_base.inverse() * estimate.T_map_base);

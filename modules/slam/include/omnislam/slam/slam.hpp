@@ -14,6 +14,7 @@
 #include "omnislam/slam/loop_closure.hpp"
 #include "omnislam/slam/loop_job.hpp"
 #include "omnislam/slam/nearest_neighbors.hpp"
+#include "omnislam/slam/odometry_scale.hpp"
 #include "omnislam/slam/point_map.hpp"
 #include "omnislam/slam/ray_agreement.hpp"
 #include "omnislam/slam/relocalizer.hpp"
@@ -99,6 +100,12 @@ struct SlamConfig {
   /// closes, the keyframe poses are optimised, the map is rebuilt from them and the current
   /// pose follows the correction.
   LoopClosureConfig loop_closure;
+  /// The odometry's distance factor, learnt where the scans pin the position in every
+  /// direction (slam/odometry_scale.hpp) and applied to each odometry step: along a plain
+  /// corridor, where the prior holds the odometry's position, a wheel reading 3% long would
+  /// put the robot 3% of the corridor ahead. Needs odometry_prior (which tells the pinned
+  /// frames apart).
+  OdometryScaleConfig odometry_scale;
 };
 
 /// Which registration was accepted for a frame.
@@ -158,7 +165,10 @@ struct ResumedGraph {
 class Slam {
  public:
   explicit Slam(SlamConfig config = {})
-      : config_(config), map_(config.map), keyframes_(config.loop_closure.keyframes) {}
+      : config_(config),
+        map_(config.map),
+        keyframes_(config.loop_closure.keyframes),
+        odometry_scale_(config.odometry_scale) {}
 
   /// Processes one local scan (base_link points, metres) with the odometry pose of the
   /// same frame (any fixed odom frame). The first frame defines the map frame, unless the
@@ -214,6 +224,8 @@ class Slam {
   void set_pose(const Eigen::Isometry2d &T_map_base, const Eigen::Matrix3d &covariance);
 
   [[nodiscard]] const PointMap &map() const { return map_; }
+  /// The odometry's distance factor as learnt so far (SlamConfig::odometry_scale).
+  [[nodiscard]] const OdometryScale &odometry_scale() const { return odometry_scale_; }
   /// Every processed frame's pose following the optimised pose graph (its keyframe's pose
   /// composed with where the frame was relative to it); without loop closure, the poses
   /// as they were estimated.
@@ -313,6 +325,9 @@ class Slam {
                                           const LocalizationResult &found);
   /// What every frame ends with: its place in the trajectory (unless the graph recorded it),
   /// the loop flags, and the state the next frame is predicted from.
+  /// Feeds the frame to the odometry's distance factor (SlamConfig::odometry_scale).
+  void learn_odometry_scale(const FrameEstimate &estimate,
+                            const std::optional<Eigen::Isometry2d> &T_odom_base);
   [[nodiscard]] FrameEstimate finish_frame(FrameEstimate estimate, const Points2 &scan_base,
                                            const std::optional<Eigen::Isometry2d> &T_odom_base,
                                            bool in_graph);
@@ -338,6 +353,7 @@ class Slam {
   SlamConfig config_;
   PointMap map_;
   KeyframeGraph keyframes_;
+  OdometryScale odometry_scale_;
   std::optional<LoopMatch> pending_loop_;  ///< the previous keyframe's verified loop, to be confirmed
   std::optional<LoopMatch> last_loop_;     ///< the last loop edge added (narrows the next search)
   int loop_closures_ = 0;
