@@ -23,6 +23,9 @@ namespace omnislam::app {
   record.mapped = frame.estimate.mapped;
   record.loop_closed = frame.estimate.loop_closed;
   record.attempt = frame.estimate.attempt;
+  record.odometry_scale = frame.estimate.odometry_scale;
+  record.odometry_scale_sigma = frame.estimate.odometry_scale_sigma;
+  record.odometry_scale_applied = frame.estimate.odometry_scale_applied;
   record.srel_percent = frame.estimate.registration.srel_percent;
   record.iterations = frame.estimate.registration.iterations;
   record.scan_points = static_cast<int>(frame.scan.points.size());

@@ -230,6 +230,13 @@ void OutputWriter::write_all(const RunRecord &all, const slam::PointMap &map, co
   summary["loop_closures"] =
       std::count_if(run.frames.begin(), run.frames.end(), [](auto &f) { return f.loop_closed; });
   summary["map_points"] = map.points().size();
+  if (!run.frames.empty()) {
+    // How far the odometry reads long or short, as the scans measured it by the last frame.
+    const FrameRecord &last = run.frames.back();
+    summary["odometry_scale"] = {{"factor", last.odometry_scale},
+                                 {"sigma", last.odometry_scale_sigma},
+                                 {"applied", last.odometry_scale_applied}};
+  }
   summary["stage_ms"] = stage_statistics(run.frames);
   std::vector<double> latency_ms;
   long dropped = 0;

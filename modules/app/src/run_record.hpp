@@ -32,6 +32,9 @@ struct FrameRecord {
   bool mapped = false;       ///< its scan was integrated into the map (slam::FrameEstimate::mapped)
   bool loop_closed = false;  ///< a loop closure corrected the graph at this frame
   slam::Attempt attempt = slam::Attempt::kNone;
+  double odometry_scale = 1.0;  ///< the odometry's distance factor learnt so far (slam::FrameEstimate)
+  double odometry_scale_sigma = 0.0;
+  bool odometry_scale_applied = false;
   double srel_percent = 0.0;
   int iterations = 0;
   int scan_points = 0;

@@ -800,6 +800,9 @@ FrameEstimate Slam::finish_frame(FrameEstimate estimate, const Points2 &scan_bas
   closed_since_frame_ = rebuilt_since_frame_ = false;
   previous_failed_ = !estimate.integrated;
   learn_odometry_scale(estimate, T_odom_base);
+  estimate.odometry_scale = odometry_scale_.scale();
+  estimate.odometry_scale_sigma = odometry_scale_.sigma();
+  estimate.odometry_scale_applied = odometry_scale_.significant();
   if (T_odom_base) set_anchor(*T_odom_base, estimate.T_map_base);
   // Extrapolated through gaps, re-made a rotation: the inverse transposes (planar_pose.hpp).
   last_step_ = orthonormalized(previous_.T_map_base.inverse() * estimate.T_map_base);

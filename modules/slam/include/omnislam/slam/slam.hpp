@@ -148,6 +148,11 @@ struct FrameEstimate {
   bool lost = false;
   /// The frame a lost robot was found again at (its pose from the whole-map search).
   bool relocalized = false;
+  /// The odometry's distance factor learnt up to this frame, its standard deviation, and
+  /// whether it is applied to the odometry (SlamConfig::odometry_scale).
+  double odometry_scale = 1.0;
+  double odometry_scale_sigma = 0.0;
+  bool odometry_scale_applied = false;
   /// This frame's index in Slam::trajectory() (-1: not recorded there, e.g. the frame a
   /// relocalisation confirmed; the trajectory starts afresh at resume()).
   int trajectory_index = -1;
