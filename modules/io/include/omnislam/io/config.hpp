@@ -34,7 +34,8 @@
 ///            min_scan_points, use_odometry, no_odometry_min_srel_percent, no_odometry_max_rotation_deg,
 ///            fusion_radius_m, noise_radius_m, noise_min_neighbors, prune_every, prune_min_hits,
 ///            prune_min_age, localization_only, map_min_step_m, lost_after_frames,
-///            loop_closure: {...; keyframe_max_scans: docs/slam.md "Loop closure"}}
+///            loop_closure: {...; keyframe_max_scans: docs/slam.md "Loop closure"},
+///            odometry_scale: {enabled, prior_sigma, significance_sigmas, outlier_sigmas}}
 /// degradation: {seed, center_px: [u, v],
 ///               exposure: {enabled, max_change}, vignetting: {enabled, rim_falloff, rim_radius_px},
 ///               dust: {enabled, count, min_radius_px, max_radius_px, min_opacity, max_opacity,
