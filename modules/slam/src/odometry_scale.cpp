@@ -28,7 +28,7 @@ bool OdometryScale::significant() const {
 void OdometryScale::add_step(const Eigen::Isometry2d &T_odom_base, const Eigen::Matrix2d &step_covariance) {
   if (reference_ && last_odom_) {
     // The step's noise, from its own start frame into the segment's.
-    const Eigen::Matrix2d R = reference_->T_odom_base.linear().transpose() * last_odom_->linear();
+    const Eigen::Matrix2d R = (reference_->T_odom_base.inverse() * *last_odom_).linear();
     segment_covariance_ += R * step_covariance * R.transpose();
   }
   last_odom_ = T_odom_base;
@@ -40,12 +40,9 @@ void OdometryScale::pin(const Eigen::Isometry2d &T_odom_base, const Eigen::Isome
     // Both displacements in the segment's start frame: the odometry's own, and the one the
     // registrations put between the two pinned poses. Only the component along the
     // odometry's is the distance (a heading error turns the rest).
-    const Eigen::Matrix2d R_odom = reference_->T_odom_base.linear().transpose();
-    const Eigen::Matrix2d R_map = reference_->T_map_base.linear().transpose();
-    const Eigen::Vector2d odometry =
-        R_odom * (T_odom_base.translation() - reference_->T_odom_base.translation());
-    const Eigen::Vector2d estimated =
-        R_map * (T_map_base.translation() - reference_->T_map_base.translation());
+    const Eigen::Vector2d odometry = (reference_->T_odom_base.inverse() * T_odom_base).translation();
+    const Eigen::Vector2d estimated = (reference_->T_map_base.inverse() * T_map_base).translation();
+    const Eigen::Matrix2d R_map = reference_->T_map_base.inverse().linear();
     const double distance = odometry.norm();
     if (distance >= kMinSegmentM) {
       const Eigen::Vector2d along = odometry / distance;
