@@ -5,6 +5,7 @@
 #include <random>
 
 #include "omnislam/slam/odometry_noise.hpp"
+#include "omnislam/slam/planar_pose.hpp"
 #include "omnislam/slam/slam.hpp"
 #include "synthetic_room.hpp"
 
@@ -66,17 +67,6 @@ RunErrors run(const SlamConfig &config, std::uint64_t seed, const std::vector<Ei
   }
   errors.map_points = slam.map().points().size();
   return errors;
-}
-
-// A pose covariance carried from `from` to `to` by a motion taken as exact: the heading's
-// error swings the position by the lever arm between the two poses.
-Eigen::Matrix3d carried_by_motion(const Eigen::Matrix3d &covariance, const Eigen::Isometry2d &from,
-                                  const Eigen::Isometry2d &to) {
-  const Eigen::Vector2d lever = to.translation() - from.translation();
-  Eigen::Matrix3d F = Eigen::Matrix3d::Identity();
-  F(0, 2) = -lever.y();
-  F(1, 2) = lever.x();
-  return F * covariance * F.transpose();
 }
 
 }  // namespace
@@ -158,15 +148,15 @@ TEST_CASE("SLAM: the published covariance carries the previous pose's and adds e
     const auto estimate = slam.process(omnislam::test::scan_from(walls, truth, rng), truth);
     if (i > 0) {
       REQUIRE(estimate.integrated);
-      const Eigen::Matrix3d carried = carried_by_motion(walk, previous_pose, estimate.T_map_base);
-      const double carried_size = carried.topLeftCorner<2, 2>().trace();
+      const Eigen::Matrix3d before = omnislam::slam::carried(walk, previous_pose, estimate.T_map_base);
+      const double carried_size = before.topLeftCorner<2, 2>().trace();
       const double walk_size = walk.topLeftCorner<2, 2>().trace();
       // Carrying rescales the walk's earlier terms alike: its degrees of freedom stay.
       if (walk_size > 0.0) shares *= (carried_size * carried_size) / (walk_size * walk_size);
       const Eigen::Matrix3d &term = estimate.registration.robust_covariance;
       REQUIRE(estimate.registration.covariance_dof == 7.0);
       shares += std::pow(term.topLeftCorner<2, 2>().trace(), 2) / 7.0;
-      walk = carried + term;
+      walk = before + term;
       const double dof = std::pow(walk.topLeftCorner<2, 2>().trace(), 2) / shares;
       factor = dof / (dof - 2.0);
       const Eigen::Matrix3d expected = factor * walk;
@@ -262,7 +252,7 @@ TEST_CASE("SLAM: a sequential edge carries the tracking's covariance between its
       continue;
     }
     REQUIRE(estimate.integrated);
-    since = carried_by_motion(since, previous_pose, estimate.T_map_base) +
+    since = omnislam::slam::carried(since, previous_pose, estimate.T_map_base) +
             estimate.registration.robust_covariance;
     previous_pose = estimate.T_map_base;
     if (!estimate.keyframe) continue;

@@ -26,7 +26,7 @@ bool OdometryScale::significant() const {
 }
 
 void OdometryScale::add_step(const Eigen::Isometry2d &T_odom_base, const Eigen::Matrix2d &step_covariance) {
-  if (reference_ && last_odom_) {
+  if (reference_) {  // a reference implies the odometry since it (break_chain resets both)
     // The step's noise, from its own start frame into the segment's.
     const Eigen::Matrix2d R = (reference_->T_odom_base.inverse() * *last_odom_).linear();
     segment_covariance_ += R * step_covariance * R.transpose();
@@ -36,7 +36,7 @@ void OdometryScale::add_step(const Eigen::Isometry2d &T_odom_base, const Eigen::
 
 void OdometryScale::pin(const Eigen::Isometry2d &T_odom_base, const Eigen::Isometry2d &T_map_base,
                         const Eigen::Matrix2d &position_covariance) {
-  if (reference_ && last_odom_) {
+  if (reference_) {
     // Both displacements in the segment's start frame: the odometry's own, and the one the
     // registrations put between the two pinned poses. Only the component along the
     // odometry's is the distance (a heading error turns the rest).
