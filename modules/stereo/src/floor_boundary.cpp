@@ -50,6 +50,14 @@ int polarity(const vision::EdgeImage &edges, int row, int column) {
   return edges.grad_row.at<std::int16_t>(row, column) >= 0 ? 1 : -1;
 }
 
+// How many rows an edge moves per column along itself: its gradient's normal in the panorama
+// (the stereo match on a misaligned rig follows it to the epipolar curve; row_triangulator.hpp).
+float rows_per_column(const vision::EdgeImage &edges, const vision::EdgePoint &edge, int column) {
+  const auto along = static_cast<float>(edges.grad_row.at<std::int16_t>(edge.row, column));
+  const auto across = static_cast<float>(edges.grad_col.at<std::int16_t>(edge.row, column));
+  return along != 0.0f ? -across / along : 0.0f;
+}
+
 // interpolate()'s arithmetic for a whole panorama row: the two rows around `row` of a lobe
 // with `rows` rows and the fraction between them.
 struct RowBlend {
@@ -648,7 +656,8 @@ BoundaryStats FloorBoundaryFinder::find(const FloorGeometry &geometry, const cv:
         continue;
       }
       if (match != nullptr) {
-        const auto stereo = triangulator.triangulate(column, edge.row_subpx, match->row_subpx);
+        const auto stereo = triangulator.triangulate(column, edge.row_subpx, match->row_subpx,
+                                                     rows_per_column(outer_edges, *match, column));
         if (!stereo) continue;
         ++stats.elevated;
         points.push_back({.column = column,
@@ -656,7 +665,8 @@ BoundaryStats FloorBoundaryFinder::find(const FloorGeometry &geometry, const cv:
                           .outer_row = match->row_subpx,
                           .range_m = stereo->range_m,
                           .height_m = stereo->height_m,
-                          .elevated = true});
+                          .elevated = true,
+                          .azimuth_shift_rad = stereo->azimuth_shift_rad});
         boundary_m = static_cast<float>(stereo->range_m);
         break;
       }
@@ -714,6 +724,7 @@ BoundaryStats FloorBoundaryFinder::find(const FloorGeometry &geometry, const cv:
         if (!stereo) continue;
         point.range_m = stereo->range_m;
         point.height_m = stereo->height_m;
+        point.azimuth_shift_rad = stereo->azimuth_shift_rad;
       }
       // 5. A table top is nearer in plan than the floor seen under it, yet higher in the
       //    image: an edge above the floor boundary that matches decisively above the floor
@@ -727,7 +738,8 @@ BoundaryStats FloorBoundaryFinder::find(const FloorGeometry &geometry, const cv:
             elevated_match(high, column, inner_edges, outer_edges, outer_edges_here, limits, window,
                            geometry_->vertical_outer_row_at(high.row, base->row_subpx), outer_row);
         if (high_match == nullptr) continue;
-        const auto stereo = triangulator.triangulate(column, high.row_subpx, high_match->row_subpx);
+        const auto stereo = triangulator.triangulate(column, high.row_subpx, high_match->row_subpx,
+                                                     rows_per_column(outer_edges, *high_match, column));
         if (stereo && stereo->range_m < point.range_m) {
           ++stats.elevated;
           point = {.column = column,
@@ -735,7 +747,8 @@ BoundaryStats FloorBoundaryFinder::find(const FloorGeometry &geometry, const cv:
                    .outer_row = high_match->row_subpx,
                    .range_m = stereo->range_m,
                    .height_m = stereo->height_m,
-                   .elevated = true};
+                   .elevated = true,
+                   .azimuth_shift_rad = stereo->azimuth_shift_rad};
         }
       }
       points.push_back(point);

@@ -210,7 +210,7 @@ double ScanReconstructor::stereo_range_per_px(int column, float inner_row, float
     if (above) return 2.0 * (*above - range_m);
     return std::numeric_limits<double>::infinity();
   };
-  auto range_of = [](const std::optional<mirror::MeridianPoint> &point) {
+  auto range_of = [](const std::optional<ColumnPoint> &point) {
     return point ? std::optional<double>(point->range_m) : std::nullopt;
   };
   const double inner = per_px(
@@ -225,8 +225,9 @@ double ScanReconstructor::floor_range_per_px(float inner_row) const {
                   floor_geometry_.floor_range_at(inner_row - 0.5));
 }
 
-void ScanReconstructor::add_point(int column, double range_m, double height_m, float inner_row,
-                                  float outer_row, bool floor_ranged, bool elevated, LocalScan &scan) {
+void ScanReconstructor::add_point(int column, double range_m, double height_m, double azimuth_shift_rad,
+                                  float inner_row, float outer_row, bool floor_ranged, bool elevated,
+                                  LocalScan &scan) {
   if (range_m < config_.stereo.near_cutoff_m || range_m > config_.stereo.far_cutoff_m) {
     ++scan.stats.outside_cutoffs;
     return;
@@ -234,7 +235,13 @@ void ScanReconstructor::add_point(int column, double range_m, double height_m, f
   const double range_per_px_m = floor_ranged ? floor_range_per_px(inner_row)
                                              : stereo_range_per_px(column, inner_row, outer_row, range_m);
   const auto c = static_cast<std::size_t>(column);
-  scan.points.push_back({column_azimuth_rad_[c], range_m, range_m * column_cos_[c], range_m * column_sin_[c],
+  double azimuth = column_azimuth_rad_[c], cos_azimuth = column_cos_[c], sin_azimuth = column_sin_[c];
+  if (azimuth_shift_rad != 0.0) {
+    azimuth = std::fmod(azimuth + azimuth_shift_rad + kTwoPi, kTwoPi);
+    cos_azimuth = std::cos(azimuth);
+    sin_azimuth = std::sin(azimuth);
+  }
+  scan.points.push_back({azimuth, range_m, range_m * cos_azimuth, range_m * sin_azimuth,
                          config_.camera_height_m + height_m, inner_row, outer_row, column,
                          static_cast<float>(range_per_px_m), floor_ranged, elevated});
 }
@@ -250,8 +257,8 @@ void ScanReconstructor::build_boundary_scan(LocalScan &scan) {
   scan.stats.noise_scale = boundary_stats_.noise_scale;
   scan.stats.twin_spread_px = boundary_stats_.twin_spread_px;
   for (const BoundaryPoint &point : boundary_points_) {
-    add_point(point.column, point.range_m, point.height_m, point.inner_row, point.outer_row,
-              point.floor_ranged, point.elevated, scan);
+    add_point(point.column, point.range_m, point.height_m, point.azimuth_shift_rad, point.inner_row,
+              point.outer_row, point.floor_ranged, point.elevated, scan);
   }
   // One boundary per column already; the per-degree filter matters only for finer panoramas.
   if (config_.stereo.one_point_per_degree)
@@ -275,8 +282,8 @@ void ScanReconstructor::build_scan(const std::vector<RowMatch> &matches, LocalSc
       ++scan.stats.no_intersection;
       continue;
     }
-    add_point(match.column, point->range_m, point->height_m, match.inner_row, match.outer_row, false, false,
-              scan);
+    add_point(match.column, point->range_m, point->height_m, point->azimuth_shift_rad, match.inner_row,
+              match.outer_row, false, false, scan);
   }
   if (stereo.one_point_per_degree) scan.stats.filtered_out = keep_nearest_per_degree(scan.points, filtered_);
   scan.stats.points = static_cast<int>(scan.points.size());

@@ -64,9 +64,10 @@ struct BoundaryPoint {
   float inner_row = 0.0f;
   float outer_row = 0.0f;
   double range_m = 0.0;
-  double height_m = 0.0;      ///< relative to the pinhole (the floor is -camera_height_m for a contact)
-  bool floor_ranged = false;  ///< ranged from the floor plane (inner row only), not by stereo
-  bool elevated = false;      ///< an edge above the floor (step 2 or 5), not a floor contact
+  double height_m = 0.0;           ///< relative to the pinhole (the floor is -camera_height_m for a contact)
+  bool floor_ranged = false;       ///< ranged from the floor plane (inner row only), not by stereo
+  bool elevated = false;           ///< an edge above the floor (step 2 or 5), not a floor contact
+  double azimuth_shift_rad = 0.0;  ///< off the column's azimuth (a misaligned rig's stereo point)
 };
 
 struct BoundaryStats {

@@ -16,6 +16,16 @@
 
 namespace omnislam::stereo {
 
+/// A point triangulated from the rows of one panorama column.
+struct ColumnPoint {
+  double range_m = 0.0;   ///< from the camera axis
+  double height_m = 0.0;  ///< relative to the pinhole
+  /// The point's azimuth less the column's: 0 on a designed rig, whose two lobes' columns
+  /// show the same vertical half-plane; on a misaligned rig a point off the floor lies
+  /// slightly beside its column's designed ray.
+  double azimuth_shift_rad = 0.0;
+};
+
 /// Precomputes, once, the elevation of every 1/32 row of both lobes (linear interpolation
 /// between them is exact to ~1e-7 rad) and, for kTable, the 225x225 table. Const and
 /// thread-safe after construction.
@@ -27,14 +37,18 @@ class RowTriangulator {
   /// both foci or a row is outside the panorama.
   [[nodiscard]] std::optional<mirror::MeridianPoint> triangulate(float inner_row, float outer_row) const;
 
-  /// The same for the rows of panorama column `column`. For a misaligned rig
-  /// (config.rig not nominal; issue 12) the rows are taken back to image positions through
-  /// the panorama maps (linear between integer rows), the two pixels back-projected by
-  /// the general model and the rays' closest point returned as (range from the camera
-  /// axis, height); both methods then use this path. For a nominal rig it is exactly
-  /// triangulate(inner_row, outer_row).
-  [[nodiscard]] std::optional<mirror::MeridianPoint> triangulate(int column, float inner_row,
-                                                                 float outer_row) const;
+  /// The same for the rows of panorama column `column`. For a nominal rig it is exactly
+  /// triangulate(inner_row, outer_row). For a misaligned rig (config.rig not nominal;
+  /// issue 12) the panoramas agree on the floor only: off the floor the point the inner
+  /// pixel sees lies in the outer panorama a fraction of a column aside, on the epipolar
+  /// curve of the inner ray. The outer edge is followed there along its own slope in the
+  /// panorama (`outer_rows_per_column`, d row / d column along the edge; 0 takes it as
+  /// level) to the column where its ray meets the inner ray (a secant search on the rays'
+  /// coplanarity), and the rays' closest point gives range, height and the azimuth shift.
+  /// The rays are the general model's at every panorama pixel, traced once at
+  /// construction, interpolated between rows and columns. Both methods then use this path.
+  [[nodiscard]] std::optional<ColumnPoint> triangulate(int column, float inner_row, float outer_row,
+                                                       float outer_rows_per_column = 0.0f) const;
 
   /// Elevation (rad, from the nadir) of a fractional row, interpolated in the table.
   [[nodiscard]] double theta_of_row(mirror::Lobe lobe, float row) const;
@@ -47,14 +61,21 @@ class RowTriangulator {
   std::vector<double> theta_outer_;
   std::optional<mirror::TriangulationTable> table_;
 
-  /// Only for a misaligned rig: the general model and the panorama maps.
+  /// Only for a misaligned rig: each lobe's world ray (origin, direction; NaN where the
+  /// lobe is missed) at every panorama pixel, row-major.
+  struct RayGrid {
+    int rows = 0;
+    int columns = 0;
+    std::vector<Eigen::Matrix<float, 6, 1>> rays;
+  };
   struct Rig {
-    mirror::RigModel model;
-    mirror::PanoramaMap inner;
-    mirror::PanoramaMap outer;
+    RayGrid inner;
+    RayGrid outer;
   };
   std::optional<Rig> rig_;
-  [[nodiscard]] std::optional<mirror::Ray3> rig_ray(mirror::Lobe lobe, int column, float row) const;
+  static RayGrid trace_rays(const mirror::MirrorModel &model, mirror::Lobe lobe);
+  /// The ray of a fractional panorama position of a misaligned rig.
+  [[nodiscard]] std::optional<mirror::Ray3> rig_ray(mirror::Lobe lobe, double column, double row) const;
 };
 
 }  // namespace omnislam::stereo

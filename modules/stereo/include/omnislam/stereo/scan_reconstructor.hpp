@@ -83,9 +83,10 @@ class ScanReconstructor {
   /// at n (noise_edges_per_panorama) of the panorama's N pixels.
   void measure_noise_gain();
   /// Adds the point unless outside the cut-offs, with its range per pixel (of the floor
-  /// plane's range when `floor_ranged`, else of the stereo range).
-  void add_point(int column, double range_m, double height_m, float inner_row, float outer_row,
-                 bool floor_ranged, bool elevated, LocalScan &scan);
+  /// plane's range when `floor_ranged`, else of the stereo range), at the column's azimuth
+  /// moved by `azimuth_shift_rad` (RowTriangulator's ColumnPoint).
+  void add_point(int column, double range_m, double height_m, double azimuth_shift_rad, float inner_row,
+                 float outer_row, bool floor_ranged, bool elevated, LocalScan &scan);
   /// ScanPoint::range_per_px_m of a stereo point: the range's central difference over one
   /// pixel of each row (one-sided where the other side loses the intersection), combined
   /// as independent errors; infinite when neither side of a row intersects.
