@@ -166,3 +166,24 @@ TEST_CASE("dataset.yaml: an images pattern other than one %d field is refused", 
   std::ofstream(dir / "dataset.yaml") << "frames: 2\nimages: \"img-100%%/%04d.png\"\n";
   CHECK(omnislam::io::read_dataset_info(dir).image(7) == dir / "img-100%/0007.png");
 }
+
+TEST_CASE("dataset.yaml: the camera height a calibration wrote into the camera line", "[io][bad-input]") {
+  // `omnislam calibrate target` writes camera: {..., camera_height_m}: the height its floor
+  // boards measured, which goes with the rig it fitted.
+  const fs::path dir = fs::temp_directory_path() / "omnislam-test-bad-input" / "height";
+  fs::create_directories(dir);
+  std::ofstream(dir / "dataset.yaml") << "camera: {focal_scale: 1.002, camera_height_m: 0.9983}\nframes: 2\n";
+  CHECK(omnislam::io::read_dataset_info(dir).camera_height_m == 0.9983);
+  std::ofstream(dir / "dataset.yaml") << "camera: {camera_height_m: 0.9983}\ncamera_height_m: 0.9983\n";
+  CHECK(omnislam::io::read_dataset_info(dir).camera_height_m == 0.9983);
+  std::ofstream(dir / "dataset.yaml") << "camera_height_m: 0.8\n";
+  CHECK(omnislam::io::read_dataset_info(dir).camera_height_m == 0.8);
+  std::ofstream(dir / "dataset.yaml") << "camera: {camera_height_m: 0.9983}\ncamera_height_m: 1.0\n";
+  CHECK_THROWS_WITH(
+      omnislam::io::read_dataset_info(dir),
+      Catch::Contains("dataset.yaml:2:") && Catch::Contains("'camera_height_m' disagrees with "
+                                                            "camera.camera_height_m (0.998300)"));
+  std::ofstream(dir / "dataset.yaml") << "camera: {camera_height_m: -1}\n";
+  CHECK_THROWS_WITH(omnislam::io::read_dataset_info(dir),
+                    Catch::Contains("'camera.camera_height_m' must be positive"));
+}

@@ -146,17 +146,24 @@ void write_yaml(const std::string &file, const calib::TargetFitResult &fit) {
       s[calib::kOffsetY]);
   out << text;
   if (std::isfinite(fit.camera_height_m)) {
-    std::snprintf(text, sizeof text, "# camera height above the floor (boards on it): %.4f +- %.4f m\n",
+    std::snprintf(text, sizeof text,
+                  "# camera height above the floor (boards on it): %.4f +- %.4f m; the rig above was fitted "
+                  "with it, so it goes with them (a tape's height would scale every floor range)\n",
                   fit.camera_height_m, fit.camera_height_sigma_m);
     out << text;
   }
   std::snprintf(text, sizeof text,
                 "camera: {center_px: [%.4f, %.4f], focal_scale: %.6f, mirror_dz_mm: %.4f, "
-                "mirror_tilt_deg: [%.5f, %.5f], mirror_offset_mm: [%.4f, %.4f]}\n",
+                "mirror_tilt_deg: [%.5f, %.5f], mirror_offset_mm: [%.4f, %.4f]",
                 c.center_u_px, c.center_v_px, c.rig.focal_scale, c.rig.mirror_dz_mm,
                 c.rig.mirror_tilt_x_rad * kDeg, c.rig.mirror_tilt_y_rad * kDeg, c.rig.mirror_offset_x_mm,
                 c.rig.mirror_offset_y_mm);
   out << text;
+  if (std::isfinite(fit.camera_height_m)) {
+    std::snprintf(text, sizeof text, ", camera_height_m: %.4f", fit.camera_height_m);
+    out << text;
+  }
+  out << "}\n";
   if (!out) throw std::runtime_error(file + ": cannot write");
 }
 

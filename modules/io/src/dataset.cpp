@@ -1,6 +1,8 @@
 #include "omnislam/io/dataset.hpp"
 
+#include <cmath>
 #include <cstdio>
+#include <limits>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -42,9 +44,16 @@ DatasetInfo read_dataset_info(const std::filesystem::path &dir) {
   DatasetInfo info;
   info.dir = dir;
   top.read("name", info.name);
+  // The camera line `omnislam calibrate target` writes carries the camera height the floor
+  // boards measured (consistent with the rig it fitted); the top-level key is the
+  // dataset's own. Both may be given only if they agree.
+  double calibrated_height_m = std::numeric_limits<double>::quiet_NaN();
   if (top.has("camera")) {
     detail::YamlSection camera(top.node("camera"), "camera", file);
     detail::read_camera_fields(camera, info.camera);
+    camera.read("camera_height_m", calibrated_height_m);
+    if (camera.has("camera_height_m") && !(calibrated_height_m > 0.0))
+      camera.fail("camera_height_m", "must be positive");
     camera.finish();
   }
   if (top.has("mirror")) {
@@ -52,7 +61,17 @@ DatasetInfo read_dataset_info(const std::filesystem::path &dir) {
     top.read("mirror", mirror);
     if (mirror != "thesis-2008") top.fail("mirror", "must be thesis-2008 (the only mirror supported)");
   }
+  const bool height_given = top.has("camera_height_m");
   top.read("camera_height_m", info.camera_height_m);
+  if (height_given && !(info.camera_height_m > 0.0)) top.fail("camera_height_m", "must be positive");
+  if (!std::isnan(calibrated_height_m)) {
+    if (height_given && calibrated_height_m != info.camera_height_m) {
+      top.fail("camera_height_m", "disagrees with camera.camera_height_m (" +
+                                      std::to_string(calibrated_height_m) +
+                                      "): keep one (a calibration's is what its floor boards measured)");
+    }
+    info.camera_height_m = calibrated_height_m;
+  }
   top.read("frames", info.frames);
   top.read("rate_hz", info.rate_hz);
   top.read("images", info.images);
