@@ -43,6 +43,15 @@ std::vector<std::uint8_t> file_bytes(const fs::path &file) {
   return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
 }
 
+// The version-6 file of the same state: version 7's bytes without the odometry's distance
+// factor, the last 24 bytes (has_odometry_scale, factor, sigma).
+std::vector<std::uint8_t> as_version_6(std::vector<std::uint8_t> bytes) {
+  bytes.resize(bytes.size() - 24);
+  bytes[8] = 6;
+  omnislam::test::reseal_snapshot(bytes);
+  return bytes;
+}
+
 void write_bytes(const fs::path &file, const std::vector<std::uint8_t> &bytes) {
   std::ofstream(file, std::ios::binary)
       .write(reinterpret_cast<const char *>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
@@ -64,7 +73,7 @@ TEST_CASE("snapshot: the odometry pose round-trips; version-1 files (without it)
 
   // Version 1: the same bytes without the 32-byte odometry block after map_integrations
   // (and without version 3's grid and version 4's graph sections, 8 bytes each when empty).
-  std::vector<std::uint8_t> v1 = omnislam::io::encode_snapshot(written);
+  std::vector<std::uint8_t> v1 = as_version_6(omnislam::io::encode_snapshot(written));
   v1.resize(v1.size() - 16);
   const std::size_t odometry_at = 24 + 8 + 4 * 8 + 9 * 8 + 5 * 8 + 8;
   v1.erase(v1.begin() + static_cast<std::ptrdiff_t>(odometry_at),
@@ -83,9 +92,9 @@ TEST_CASE("snapshot: written atomically and read back exactly", "[io][snapshot]"
   const fs::path dir = scratch("roundtrip");
   const Snapshot written = example();
   omnislam::io::write_snapshot(dir / "state.snap", written);
-  // 24-byte header + 200-byte fixed payload + 24 bytes per point + has_grid 0 + has_graph 0;
-  // no temporary left over.
-  CHECK(fs::file_size(dir / "state.snap") == 24 + 200 + 24 * 50 + 8 + 8);
+  // 24-byte header + 200-byte fixed payload + 24 bytes per point + has_grid 0 + has_graph 0
+  // + has_odometry_scale 0 with its two doubles; no temporary left over.
+  CHECK(fs::file_size(dir / "state.snap") == 24 + 200 + 24 * 50 + 8 + 8 + 24);
   CHECK(std::distance(fs::directory_iterator(dir), fs::directory_iterator()) == 1);
 
   const Snapshot read = omnislam::io::read_snapshot(dir / "state.snap");
@@ -136,7 +145,7 @@ TEST_CASE("snapshot: truncation, bit flips, other versions and bad values are re
   }
   const std::vector<std::uint8_t> header_only(good.begin(), good.begin() + 30);
   CHECK_THROWS_WITH(omnislam::io::decode_snapshot(header_only, "cut.snap"),
-                    Catch::Contains("cut.snap: truncated") && Catch::Contains("1416 payload bytes") &&
+                    Catch::Contains("cut.snap: truncated") && Catch::Contains("1440 payload bytes") &&
                         Catch::Contains("has 6"));
   // A flipped bit anywhere after the magic fails the checksum (or, in the size field, the length).
   for (std::size_t i = 8; i < good.size(); i += 37) {
@@ -158,13 +167,13 @@ TEST_CASE("snapshot: truncation, bit flips, other versions and bad values are re
 
 TEST_CASE("snapshot: a future version or impossible values are named even with a valid checksum",
           "[io][snapshot]") {
-  // A version-7 file (as a newer build would write it) has a valid CRC of its own.
-  std::vector<std::uint8_t> v7 = omnislam::io::encode_snapshot(example());
-  v7[8] = 7;
-  omnislam::test::reseal_snapshot(v7);
+  // A version-8 file (as a newer build would write it) has a valid CRC of its own.
+  std::vector<std::uint8_t> v8 = omnislam::io::encode_snapshot(example());
+  v8[8] = 8;
+  omnislam::test::reseal_snapshot(v8);
   CHECK_THROWS_WITH(
-      omnislam::io::decode_snapshot(v7, "v7.snap"),
-      Catch::Equals("v7.snap: unsupported snapshot version 7 (this build reads versions 1 to 6)"));
+      omnislam::io::decode_snapshot(v8, "v8.snap"),
+      Catch::Equals("v8.snap: unsupported snapshot version 8 (this build reads versions 1 to 7)"));
 
   Snapshot bad = example();
   bad.points[3].hits = 0;
@@ -250,7 +259,7 @@ TEST_CASE(
     "[io][snapshot]") {
   Snapshot written = example();
   written.grid = example_grid();
-  const std::vector<std::uint8_t> v5 = omnislam::io::encode_snapshot(written);
+  const std::vector<std::uint8_t> v5 = as_version_6(omnislam::io::encode_snapshot(written));
   CHECK(v5.size() == 24 + 200 + 24 * 50 + 8 + 32 + 21 + 21 + 8);
   const Snapshot read = omnislam::io::decode_snapshot(v5, "grid.snap");
   CHECK(read.version == 6);  // without a graph version 6's bytes are version 5's
@@ -293,7 +302,7 @@ TEST_CASE(
   CHECK_FALSE(three.graph);
 
   // Version 2: version 3 without the grid section.
-  std::vector<std::uint8_t> v2 = omnislam::io::encode_snapshot(example());
+  std::vector<std::uint8_t> v2 = as_version_6(omnislam::io::encode_snapshot(example()));
   v2.resize(v2.size() - 16);
   v2[8] = 2;
   omnislam::test::reseal_snapshot(v2);
@@ -391,9 +400,9 @@ TEST_CASE("snapshot: version 4 and later carry the keyframe graph exactly; re-en
   // The graph section: 8 (has_graph) + 32 + 3 keyframes x (40 + 72 + 40 scans x (8 + 3 x 16))
   // + 8 + 120 x 8 + 8 + 3 x 112.
   const std::size_t graph_at = 24 + 200 + 24 * 50 + 8 + 32 + 21 + 21;
-  CHECK(bytes.size() == graph_at + 8 + 32 + 8 + 3 * (40 + 72 + 40 * 56) + 8 + 960 + 8 + 336);
+  CHECK(bytes.size() == graph_at + 8 + 32 + 8 + 3 * (40 + 72 + 40 * 56) + 8 + 960 + 8 + 336 + 24);
   const Snapshot read = omnislam::io::decode_snapshot(bytes, "graph.snap");
-  CHECK(read.version == 6);
+  CHECK(read.version == 7);
   REQUIRE(read.grid);
   REQUIRE(read.graph);
   const KeyframeGraphState &want = *written.graph, &got = *read.graph;
@@ -421,7 +430,7 @@ TEST_CASE("snapshot: version 4 and later carry the keyframe graph exactly; re-en
 
   // Version 5: version 6 without the keyframes' covariances (72 bytes after each keyframe's
   // pose and path), still read, with zero covariances.
-  std::vector<std::uint8_t> v5 = bytes;
+  std::vector<std::uint8_t> v5 = as_version_6(bytes);
   for (int k = 2; k >= 0; --k) {
     const std::size_t at = graph_at + 8 + 32 + 8 + static_cast<std::size_t>(k) * (40 + 72 + 40 * 56) + 32;
     v5.erase(v5.begin() + static_cast<std::ptrdiff_t>(at), v5.begin() + static_cast<std::ptrdiff_t>(at + 72));
@@ -493,7 +502,7 @@ TEST_CASE("snapshot: a version-4 keyframe graph that does not hold together is r
           "keyframe graph: keyframe 2: covariance is not symmetric positive semi-definite");
 
   // Flags and counts edited in the bytes (the writer cannot produce them).
-  const std::vector<std::uint8_t> good = omnislam::io::encode_snapshot(example_with_graph());
+  const std::vector<std::uint8_t> good = as_version_6(omnislam::io::encode_snapshot(example_with_graph()));
   const std::size_t edges_at = good.size() - 3 * 112 - 8;  // the edge count
   std::vector<std::uint8_t> bytes = good;
   put_u64(bytes, good.size() - 112 + 8, 2);  // the last edge's loop flag
@@ -507,14 +516,57 @@ TEST_CASE("snapshot: a version-4 keyframe graph that does not hold together is r
   put_u64(bytes, edges_at, 2);
   omnislam::test::reseal_snapshot(bytes);
   rejects(bytes, "trailing bytes after the keyframe graph");
-  bytes = omnislam::io::encode_snapshot(example());
+  bytes = as_version_6(omnislam::io::encode_snapshot(example()));
   put_u64(bytes, bytes.size() - 8, 2);  // has_graph
   omnislam::test::reseal_snapshot(bytes);
   rejects(bytes, "has_graph is 2");
   // Every truncation of the graph section, resealed, is caught.
-  const std::size_t graph_at = omnislam::io::encode_snapshot(example()).size() - 8;
+  const std::size_t graph_at = as_version_6(omnislam::io::encode_snapshot(example())).size() - 8;
   for (std::size_t length = graph_at; length < good.size(); length += 7) {
     std::vector<std::uint8_t> cut(good.begin(), good.begin() + static_cast<long>(length));
+    omnislam::test::reseal_snapshot(cut);
+    CHECK_THROWS_AS(omnislam::io::decode_snapshot(cut, "cut.snap"), SnapshotError);
+  }
+}
+
+TEST_CASE("snapshot: version 7 carries the odometry's distance factor; version 6 files read without it",
+          "[io][snapshot]") {
+  Snapshot written = example_with_graph();
+  written.odometry_scale = omnislam::io::SnapshotOdometryScale{0.9712, 0.0034};
+  const std::vector<std::uint8_t> bytes = omnislam::io::encode_snapshot(written);
+  const Snapshot read = omnislam::io::decode_snapshot(bytes, "scale.snap");
+  CHECK(read.version == 7);
+  REQUIRE(read.odometry_scale);
+  CHECK(read.odometry_scale->factor == 0.9712);
+  CHECK(read.odometry_scale->sigma == 0.0034);
+  REQUIRE(read.graph);
+  CHECK(omnislam::io::encode_snapshot(read) == bytes);
+  CHECK_FALSE(
+      omnislam::io::decode_snapshot(omnislam::io::encode_snapshot(example()), "none.snap").odometry_scale);
+  // Version 6: the same state without the section, still read.
+  const Snapshot six = omnislam::io::decode_snapshot(as_version_6(bytes), "v6.snap");
+  CHECK(six.version == 6);
+  CHECK_FALSE(six.odometry_scale);
+  CHECK(six.graph->keyframes.size() == 3);
+  // A flag other than 0 or 1, a factor that is not positive, a negative sigma, and every
+  // truncation of the section are named.
+  std::vector<std::uint8_t> flag = bytes;
+  put_u64(flag, bytes.size() - 24, 3);
+  omnislam::test::reseal_snapshot(flag);
+  CHECK_THROWS_WITH(omnislam::io::decode_snapshot(flag, "flag.snap"),
+                    Catch::Equals("flag.snap: has_odometry_scale is 3"));
+  Snapshot bad = written;
+  bad.odometry_scale->factor = -1.0;
+  CHECK_THROWS_WITH(omnislam::io::decode_snapshot(omnislam::io::encode_snapshot(bad), "factor.snap"),
+                    Catch::Contains("factor.snap: odometry distance factor -1.000000"));
+  bad.odometry_scale = omnislam::io::SnapshotOdometryScale{1.01, -0.1};
+  CHECK_THROWS_AS(omnislam::io::decode_snapshot(omnislam::io::encode_snapshot(bad), "sigma.snap"),
+                  SnapshotError);
+  bad.odometry_scale->sigma = std::nan("");
+  CHECK_THROWS_WITH(omnislam::io::decode_snapshot(omnislam::io::encode_snapshot(bad), "nan.snap"),
+                    Catch::Contains("odometry scale sigma is not a finite number"));
+  for (std::size_t length = bytes.size() - 24; length < bytes.size(); ++length) {
+    std::vector<std::uint8_t> cut(bytes.begin(), bytes.begin() + static_cast<long>(length));
     omnislam::test::reseal_snapshot(cut);
     CHECK_THROWS_AS(omnislam::io::decode_snapshot(cut, "cut.snap"), SnapshotError);
   }

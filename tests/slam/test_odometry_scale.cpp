@@ -140,3 +140,36 @@ TEST_CASE("SLAM: along a plain corridor the learnt factor keeps a long-reading o
   CHECK(as_read > 0.3);  // 5% of the ~10 m the prior alone holds
   CHECK(learnt < 0.5 * as_read);
 }
+
+TEST_CASE("OdometryScale restores what an earlier run learnt and goes on learning from it",
+          "[slam][odometry_scale]") {
+  // A snapshot keeps the estimate and its sigma (io/snapshot.hpp, version 7); the same
+  // wheels resumed start from it: applied from the first step, and later segments add to it
+  // as if they had been measured in one run.
+  OdometryScale learnt;
+  drive(learnt, 1.04, 20);
+  OdometryScale resumed;
+  resumed.restore(learnt.scale(), learnt.sigma());
+  CHECK(resumed.scale() == Approx(learnt.scale()).epsilon(1e-12));
+  CHECK(resumed.sigma() == Approx(learnt.sigma()).epsilon(1e-12));
+  CHECK(resumed.significant());
+  CHECK(resumed.applied() == Approx(1.0 / 1.04).epsilon(0.003));
+  OdometryScale one_run;
+  drive(one_run, 1.04, 20);
+  one_run.break_chain();  // a second drive, its chain starting afresh as the resumed one's
+  drive(one_run, 1.04, 20);
+  drive(resumed, 1.04, 20);
+  CHECK(resumed.scale() == Approx(one_run.scale()).epsilon(1e-9));
+  CHECK(resumed.sigma() == Approx(one_run.sigma()).epsilon(1e-9));
+  // Nothing learnt (a sigma at the prior's, or none), or the estimator disabled: no change.
+  OdometryScale fresh;
+  fresh.restore(0.9, 0.05);
+  CHECK(fresh.scale() == 1.0);
+  fresh.restore(0.9, 0.0);
+  CHECK(fresh.scale() == 1.0);
+  fresh.restore(std::nan(""), 0.01);
+  CHECK(fresh.scale() == 1.0);
+  OdometryScale disabled(OdometryScaleConfig{.enabled = false});
+  disabled.restore(0.95, 0.002);
+  CHECK(disabled.applied() == 1.0);
+}

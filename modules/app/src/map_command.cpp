@@ -138,6 +138,7 @@ void save(const std::filesystem::path &run_dir, const std::filesystem::path &fil
     s.map_integrations = with_graph.map_integrations;
     s.points = std::move(with_graph.points);
     s.graph = std::move(with_graph.graph);
+    s.odometry_scale = with_graph.odometry_scale;
   } else {
     for (const io::MapPointRecord &p : io::read_map_csv(run_dir / "map.csv")) {
       s.points.push_back({{p.x_m, p.y_m}, p.hits, 0});

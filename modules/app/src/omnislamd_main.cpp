@@ -312,6 +312,11 @@ int run_service(const std::string &config_file) {
     pipeline.resume(resumed->points, resumed->map_integrations, resumed->T_map_base, resumed->covariance,
                     resumed->T_odom_base, resumed_graph(*resumed));
   }
+  if (resumed && resumed->odometry_scale) {  // the same wheels: what the saved run learnt of them
+    pipeline.restore_odometry_scale(resumed->odometry_scale->factor, resumed->odometry_scale->sigma);
+    spdlog::info("odometry distance factor from the snapshot: {:.4f} +- {:.4f}",
+                 resumed->odometry_scale->factor, resumed->odometry_scale->sigma);
+  }
   const auto initial_pose_counts = std::make_shared<InitialPoseCounts>();
   pipeline::FrameSource source = checked_source(input.source, config.scan.camera, status);
   if (initial_pose)

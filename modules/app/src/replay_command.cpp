@@ -115,6 +115,9 @@ void run_replay(const ReplayOptions &options, std::optional<std::uint64_t> degra
     run.localizing = true;
     pipeline.relocalize(std::move(snapshot.points), snapshot.map_integrations, {}, {},
                         std::move(snapshot.graph));
+    // The same wheels: what the mapping run learnt of their distance factor.
+    if (snapshot.odometry_scale)
+      pipeline.restore_odometry_scale(snapshot.odometry_scale->factor, snapshot.odometry_scale->sigma);
   }
   pipeline.run(dataset_source(info, odometry, config.scan.camera, std::move(source_options)));
   if (!pipeline.error().empty()) throw std::runtime_error(pipeline.error());
@@ -145,6 +148,8 @@ void run_replay(const ReplayOptions &options, std::optional<std::uint64_t> degra
     snapshot.map_integrations = pipeline.slam().map().integrations();
     snapshot.graph = std::move(graph);
     if (!pipeline.slam().trajectory().empty()) snapshot.T_map_base = pipeline.slam().trajectory().back();
+    if (const slam::OdometryScale &scale = pipeline.slam().odometry_scale(); scale.sigma() > 0.0)
+      snapshot.odometry_scale = io::SnapshotOdometryScale{scale.scale(), scale.sigma()};
     io::write_snapshot(snapshot_file, snapshot);
   }
 }

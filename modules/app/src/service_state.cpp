@@ -67,6 +67,7 @@ io::Snapshot make_snapshot(const FrameRecord &frame, std::vector<slam::MapPoint>
   s.points = std::move(points);
   if (grid.width > 0) s.grid = std::move(grid);
   s.graph = std::move(graph);
+  if (frame.odometry_scale_sigma > 0.0) s.odometry_scale = {frame.odometry_scale, frame.odometry_scale_sigma};
   return s;
 }
 

@@ -32,6 +32,7 @@ constexpr std::size_t kGridHeaderBytes = 4 + 4 + 8 + 8 + 8;  // version 3, when 
 constexpr std::size_t kGraphHeaderBytes = 8 + 3 * 8;
 constexpr std::size_t kKeyframeBytes = 4 * 8 + 8;
 constexpr std::size_t kKeyframeCovarianceBytes = 9 * 8;  // version 6
+constexpr std::size_t kOdometryScaleBytes = 8 + 2 * 8;   // version 7: has, factor, sigma
 constexpr std::size_t kScanBytes = 8;
 constexpr std::size_t kScanPointBytes = 8 + 8;
 constexpr std::size_t kIntegrationBytes = 4 + 4;
@@ -354,6 +355,9 @@ std::vector<std::uint8_t> encode_snapshot(const Snapshot &snapshot) {
     for (std::size_t i = 0; i < g.cells.size(); ++i) payload.i8(flagged && g.above_floor[i] != 0 ? 1 : 0);
   }
   encode_graph(payload, snapshot.graph);
+  payload.u64(snapshot.odometry_scale ? 1 : 0);
+  payload.f64(snapshot.odometry_scale ? snapshot.odometry_scale->factor : 1.0);
+  payload.f64(snapshot.odometry_scale ? snapshot.odometry_scale->sigma : 0.0);
 
   ByteWriter header;
   header.bytes.assign(kMagic.begin(), kMagic.end());
@@ -418,7 +422,8 @@ Snapshot decode_snapshot(std::span<const std::uint8_t> bytes, const std::string 
   const std::uint64_t count = in.u64();
   // Version 3 ends with the grid section (at least its u64 has_grid), version 4 with the
   // grid and graph sections (at least their two u64 flags); earlier ones with the points.
-  const std::uint64_t sections_bytes = version >= 4 ? 16 : (version == 3 ? 8 : 0);
+  const std::uint64_t sections_bytes =
+      (version >= 4 ? 16 : (version == 3 ? 8 : 0)) + (version >= 7 ? kOdometryScaleBytes : 0);
   const std::uint64_t point_bytes = payload.size() - fixed_bytes;
   const std::uint64_t announced = count <= point_bytes / kPointBytes ? count * kPointBytes : point_bytes + 1;
   const bool points_fit = version >= 3 ? announced + sections_bytes <= point_bytes
@@ -442,11 +447,29 @@ Snapshot decode_snapshot(std::span<const std::uint8_t> bytes, const std::string 
     }
     s.points.push_back(p);
   }
-  if (version >= 3) s.grid = decode_grid(in, name, version >= 4 ? 8 : 0, version >= 5);
+  if (version >= 3)
+    s.grid = decode_grid(in, name, (version >= 4 ? 8 : 0) + (version >= 7 ? kOdometryScaleBytes : 0),
+                         version >= 5);
   if (version >= 4) s.graph = decode_graph(in, name, s.map_integrations, version >= 6);
+  if (version >= 7) {
+    if (in.remaining() < kOdometryScaleBytes)
+      throw SnapshotError(name + ": truncated odometry distance factor");
+    const std::uint64_t has_scale = in.u64();
+    if (has_scale > 1) throw SnapshotError(name + ": has_odometry_scale is " + std::to_string(has_scale));
+    const double factor = in.f64("odometry scale factor"), sigma = in.f64("odometry scale sigma");
+    if (has_scale == 1) {
+      if (!(factor > 0.0) || !(sigma >= 0.0)) {
+        throw SnapshotError(name + ": odometry distance factor " + std::to_string(factor) + " +- " +
+                            std::to_string(sigma));
+      }
+      s.odometry_scale = SnapshotOdometryScale{factor, sigma};
+    }
+  }
   if (in.remaining() != 0) {
     throw SnapshotError(name + ": trailing bytes after the " +
-                        (version >= 4 ? "keyframe graph" : "occupancy grid"));
+                        (version >= 7   ? "odometry distance factor"
+                         : version >= 4 ? "keyframe graph"
+                                        : "occupancy grid"));
   }
   return s;
 }

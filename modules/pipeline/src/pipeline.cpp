@@ -89,6 +89,11 @@ void Pipeline::resume(std::vector<slam::MapPoint> points, int integrations,
   slam_.resume(std::move(points), integrations, T_map_base, covariance, T_odom_base, std::move(graph));
 }
 
+void Pipeline::restore_odometry_scale(double factor, double sigma) {
+  if (started_) throw std::logic_error("Pipeline::restore_odometry_scale after start");
+  slam_.restore_odometry_scale(factor, sigma);
+}
+
 void Pipeline::relocalize(std::vector<slam::MapPoint> points, int integrations,
                           const slam::RelocalizerConfig &config, std::optional<slam::SearchWindow> window,
                           std::optional<slam::KeyframeGraphState> graph) {

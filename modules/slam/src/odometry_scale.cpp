@@ -67,6 +67,17 @@ void OdometryScale::pin(const Eigen::Isometry2d &T_odom_base, const Eigen::Isome
   last_odom_ = T_odom_base;
 }
 
+void OdometryScale::restore(double factor, double sigma) {
+  break_chain();
+  const double prior = 1.0 / (config_.prior_sigma * config_.prior_sigma);
+  if (!config_.enabled || !std::isfinite(factor) || !(sigma > 0.0) || !std::isfinite(sigma)) return;
+  // scale() = (prior + weighted_sum) / (prior + information), sigma() = (prior + information)^-1/2.
+  const double total = 1.0 / (sigma * sigma);
+  if (total <= prior) return;
+  information_ = total - prior;
+  weighted_sum_ = factor * total - prior;
+}
+
 void OdometryScale::break_chain() {
   reference_.reset();
   last_odom_.reset();

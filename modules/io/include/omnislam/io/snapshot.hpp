@@ -17,11 +17,11 @@
 /// Snapshots of the SLAM state (map, pose, counters, configuration hash) that a service
 /// writes periodically into its state directory and resumes from after a restart.
 ///
-/// File format, version 6 (all integers and doubles little-endian):
+/// File format, version 7 (all integers and doubles little-endian):
 /// ```
 /// offset  size  field
 ///  0       8    magic "OMNISNAP"
-///  8       4    u32 format version (6)
+///  8       4    u32 format version (7)
 /// 12       8    u64 payload size in bytes
 /// 20       4    u32 CRC-32 (zlib) of bytes 8..19 followed by the payload
 /// 24       -    payload: u64 config_hash, f64 t_s, f64 x_m, f64 y_m, f64 yaw_rad,
@@ -40,19 +40,22 @@
 ///               scan u64 point count and per point f64 x_m, f64 y_m (keyframe coordinates); u64 integration
 ///               count, per integration u32 keyframe, u32 scan (within the keyframe); u64 edge count, per
 ///               edge u32 from, u32 to, u64 loop (0 or 1), f64 x_m, f64 y_m, f64 yaw_rad (pose of `to` in
-///               `from`), 9 x f64 information (row-major, x y yaw)
+///               `from`), 9 x f64 information (row-major, x y yaw),
+///               u64 has_odometry_scale (0 or 1), f64 factor, f64 sigma (the odometry's
+///               distance factor the run had learnt, slam::OdometryScale; 1 and 0 when 0)
 /// ```
-/// Version 5 is version 6 without the keyframes' covariances, version 4 version 5 without the
+/// Version 6 is version 7 without the odometry's distance factor, version 5 version 6
+/// without the keyframes' covariances, version 4 version 5 without the
 /// grid's above-floor flags, version 3 version 4 without
 /// the graph section, version 2 version 3 without the grid section, version 1 version 2
 /// without the four odometry fields; all are still read (their keyframes' covariances are
-/// zero: a run localized on such a map publishes its registrations' alone; before version 5
-/// their grid's `above_floor`, before
-/// version 4 their `graph`, and before version 3 their `grid`, are empty).
+/// zero: a run localized on such a map publishes its registrations' alone; before version 7
+/// their `odometry_scale`, before version 5 their grid's `above_floor`, before version 4
+/// their `graph`, and before version 3 their `grid`, are empty).
 
 namespace omnislam::io {
 
-inline constexpr std::uint32_t kSnapshotVersion = 6;
+inline constexpr std::uint32_t kSnapshotVersion = 7;
 
 /// A snapshot that cannot be used: missing, truncated, of another version, failing its
 /// checksum, or holding impossible values. The message names the file.
@@ -67,6 +70,12 @@ struct SnapshotCounters {
   std::uint64_t not_integrated = 0;  ///< frames that followed odometry
   std::uint64_t skipped = 0;         ///< frames whose image could not be used
   std::uint64_t dropped = 0;         ///< frames dropped by the live pipeline
+};
+
+/// The odometry's distance factor a run learnt (slam::OdometryScale: scale(), sigma()).
+struct SnapshotOdometryScale {
+  double factor = 1.0;
+  double sigma = 0.0;
 };
 
 struct Snapshot {
@@ -90,6 +99,9 @@ struct Snapshot {
   /// (version 4; slam::Slam::graph_state): a resumed run continues it and can close loops
   /// against its keyframes. Its integrations() equal map_integrations.
   std::optional<slam::KeyframeGraphState> graph;
+  /// What the run had learnt of its odometry's distance factor (version 7): the same wheels
+  /// resumed start from it (slam::Slam::restore_odometry_scale) instead of from 1.
+  std::optional<SnapshotOdometryScale> odometry_scale;
 };
 
 /// The bytes of the file format above.

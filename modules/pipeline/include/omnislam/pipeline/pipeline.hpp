@@ -86,6 +86,10 @@ class Pipeline {
               const Eigen::Matrix3d &covariance, const std::optional<Eigen::Isometry2d> &T_odom_base,
               std::optional<slam::ResumedGraph> graph = {});
 
+  /// Starts from the odometry's distance factor an earlier run learnt (a snapshot's;
+  /// slam::Slam::restore_odometry_scale). Only before start().
+  void restore_odometry_scale(double factor, double sigma);
+
   /// Starts on a saved map from an unknown pose (slam::Relocalizer): frames are searched
   /// for their pose on the map, and leave the SLAM stage with Frame::localized false until
   /// one pose is confirmed; from then on the SLAM continues from it on the saved map

@@ -58,6 +58,10 @@ class OdometryScale {
   /// (a measurement) and starts the next.
   void pin(const Eigen::Isometry2d &T_odom_base, const Eigen::Isometry2d &T_map_base,
            const Eigen::Matrix2d &position_covariance);
+  /// Continues from what an earlier run of the same wheels learnt (a snapshot): the estimate
+  /// `factor` with standard deviation `sigma` becomes this one's, as if its measurements had
+  /// been taken here (a sigma at or above the prior's adds nothing). The chain starts afresh.
+  void restore(double factor, double sigma);
   /// The odometry chain broke (a gap, a lost or carried robot, a pose set from outside) or
   /// the pinned poses moved (a loop closure): the next pinned frame starts a segment afresh.
   void break_chain();

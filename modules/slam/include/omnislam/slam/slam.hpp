@@ -231,6 +231,8 @@ class Slam {
   [[nodiscard]] const PointMap &map() const { return map_; }
   /// The odometry's distance factor as learnt so far (SlamConfig::odometry_scale).
   [[nodiscard]] const OdometryScale &odometry_scale() const { return odometry_scale_; }
+  /// Starts from the factor an earlier run of the same robot learnt (OdometryScale::restore).
+  void restore_odometry_scale(double factor, double sigma) { odometry_scale_.restore(factor, sigma); }
   /// Every processed frame's pose following the optimised pose graph (its keyframe's pose
   /// composed with where the frame was relative to it); without loop closure, the poses
   /// as they were estimated.
