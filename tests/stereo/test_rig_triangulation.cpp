@@ -73,8 +73,9 @@ TEST_CASE("row triangulator: a misaligned rig triangulates floor points from the
 namespace {
 
 // Where a lobe's panorama shows an image pixel: (column, row), fractional, by Newton's
-// method on the map's bilinear interpolation from the nearest sample.
-Eigen::Vector2d panorama_position(const omnislam::mirror::PanoramaMap &map,
+// method on the map's bilinear interpolation from the nearest sample among the columns
+// around the pixel's angle about `centre`.
+Eigen::Vector2d panorama_position(const omnislam::mirror::PanoramaMap &map, const Eigen::Vector2d &centre,
                                   const omnislam::mirror::Pixel &pixel) {
   const auto at = [&](const std::vector<float> &values, double column, double row) {
     const double wrapped = column - map.columns * std::floor(column / map.columns);
@@ -94,13 +95,16 @@ Eigen::Vector2d panorama_position(const omnislam::mirror::PanoramaMap &map,
   const Eigen::Vector2d target(pixel.u_px, pixel.v_px);
   Eigen::Vector2d best(0.0, 0.0);
   double best_distance = 1e30;
+  const double angle = std::atan2(pixel.v_px - centre.y(), pixel.u_px - centre.x());
+  const int near = static_cast<int>(std::lround(angle / (2.0 * std::numbers::pi) * map.columns));
   for (int row = 0; row < map.rows; ++row) {
-    for (int column = 0; column < map.columns; ++column) {
+    for (int offset = -8; offset <= 8; ++offset) {
+      const int column = ((near + offset) % map.columns + map.columns) % map.columns;
       const double distance = (image_of({column, row}) - target).squaredNorm();
       if (distance < best_distance) best_distance = distance, best = {column, row};
     }
   }
-  for (int step = 0; step < 20; ++step) {
+  for (int step = 0; step < 8; ++step) {
     constexpr double kH = 1e-4;
     Eigen::Matrix2d jacobian;
     jacobian.col(0) = (image_of(best + Eigen::Vector2d(kH, 0.0)) - image_of(best)) / kH;
@@ -141,11 +145,12 @@ TEST_CASE("row triangulator: a misaligned rig's stereo point off the floor follo
       const auto position = [&](Lobe lobe, double s) {
         const auto pixel = rig.project(lobe, start + s * along);
         REQUIRE(pixel);
-        return panorama_position(lobe == Lobe::kInner ? inner_map : outer_map, *pixel);
+        return panorama_position(lobe == Lobe::kInner ? inner_map : outer_map,
+                                 {config.center_u_px, config.center_v_px}, *pixel);
       };
       const auto crossing = [&](Lobe lobe, double target) {
         double s = 0.0;
-        for (int step = 0; step < 30; ++step) {
+        for (int step = 0; step < 10; ++step) {
           constexpr double kH = 1e-5;
           const double value = position(lobe, s).x() - target;
           s -= value * kH / (position(lobe, s + kH).x() - position(lobe, s).x());
