@@ -223,6 +223,8 @@ def render_key(room: Room, camera_height_m: float = CAMERA_HEIGHT_M, grey: bool 
                rig: M.Rig = M.Rig(), people: Sequence[Sequence[Pose]] = ()) -> str:
     parts = [RENDERER_VERSION, room.pov_body(), pov.camera_block(rig), pov.mirror_block(rig), ANTIALIAS,
              repr(camera_height_m)]
+    if rig.level_tilt_deg != (0.0, 0.0):
+        parts.append(f"level tilt {rig.level_tilt_deg!r}")
     if any(people):
         parts.append(repr([[tuple(round(v, 6) for v in p) for p in frame] for frame in people]))
     text = "|".join(parts + (["grey"] if grey else []))
@@ -360,7 +362,8 @@ def render_images(spec: DatasetSpec, out: Path, world: Sequence[Pose], threads: 
             else:
                 pov_file = Path(tmp) / f"{i:06d}.pov"
                 extra = "\n  ".join(person_pov(*p) for p in people[i - 1])
-                pov_file.write_text(frame_scene(room, pose, spec.camera_height_m, camera, mirror, extra))
+                pov_file.write_text(frame_scene(room, pose, spec.camera_height_m, camera, mirror, extra,
+                                                rig.level_tilt_deg))
                 png_tmp = Path(tmp) / f"{i:06d}.png"
                 times.append(pov.render(pov_file, png_tmp, threads=threads, antialias=ANTIALIAS,
                                         grey=spec.grey))

@@ -148,12 +148,15 @@ class Rig:
         p_camera = R (p_design - pivot) + pivot + (offset_x, offset_y, dz),
         R = Ry(tilt_y) Rx(tilt_x),  pivot = (0, 0, z of the inner focus),
     the true focal length is focal_scale * FOCAL_MM and the optical axis is at center_px.
-    The defaults are the design."""
+    level_tilt_deg turns the whole rig (camera and mirror) about the pinhole away from
+    level, about the camera x then y axis (right-handed, R = Ry(y) Rx(x)): the world seen
+    from the camera is turned by R^T (config key level_tilt_deg). The defaults are the design."""
     focal_scale: float = 1.0
     mirror_dz_mm: float = 0.0
     tilt_deg: tuple[float, float] = (0.0, 0.0)
     offset_mm: tuple[float, float] = (0.0, 0.0)
     center_px: tuple[float, float] = (CENTER_PX, CENTER_PX)
+    level_tilt_deg: tuple[float, float] = (0.0, 0.0)
     # A support rod holding the mirror (the thesis's rig had one, "haste de suporte"): a
     # vertical cylinder beside the mirror's rim at this robot-frame azimuth (deg), seen by
     # both lobes, never by the camera directly. Not part of the camera model: no config key.
@@ -204,6 +207,8 @@ class Rig:
             out += f", mirror_tilt_deg: [{self.tilt_deg[0]!r}, {self.tilt_deg[1]!r}]"
         if self.offset_mm != (0.0, 0.0):
             out += f", mirror_offset_mm: [{self.offset_mm[0]!r}, {self.offset_mm[1]!r}]"
+        if self.level_tilt_deg != (0.0, 0.0):
+            out += f", level_tilt_deg: [{self.level_tilt_deg[0]!r}, {self.level_tilt_deg[1]!r}]"
         return out
 
 

@@ -403,16 +403,26 @@ def person_pov(x: float, y: float, heading: float, colour: Colour = (0.22, 0.24,
     return "\n  ".join([*(c.pov() for c in (*legs, torso)), head])
 
 
+def level_tilt_transform(level_tilt_deg: tuple[float, float]) -> str:
+    """POV transform taking the level camera frame into a rig turned off level by
+    R = Ry(y) Rx(x) (mirror.Rig.level_tilt_deg): p_camera = R^T p_level, Ry(-y) first.
+    POV's rotate applies the right-handed matrix to the coordinates as written."""
+    x, y = level_tilt_deg
+    if (x, y) == (0.0, 0.0):
+        return ""
+    return f" rotate {vec(0.0, -y, 0.0)} rotate {vec(-x, 0.0, 0.0)}"
+
+
 def frame_scene(room: Room, pose: Pose, camera_height_m: float, camera: str, mirror: str,
-                extra: str = "") -> str:
+                extra: str = "", level_tilt_deg: tuple[float, float] = (0.0, 0.0)) -> str:
     """One frame: the room (and `extra`, objects of this frame alone in room coordinates, mm)
-    moved into the camera frame of the robot at `pose`."""
+    moved into the camera frame of the robot at `pose` (turned off level by `level_tilt_deg`)."""
     return (
         "#version 3.7;\n"
         "global_settings { assumed_gamma 1.0 ambient_light rgb 1 max_trace_level 5 }\n"
         f"// room {room.name}, robot pose x={pose[0]!r} m y={pose[1]!r} m yaw={pose[2]!r} rad\n"
         "union {\n  " + room.pov_body() + ("\n  " + extra if extra else "") + "\n"
-        f"  {world_to_camera_matrix(pose, camera_height_m)}\n}}\n"
+        f"  {world_to_camera_matrix(pose, camera_height_m)}{level_tilt_transform(level_tilt_deg)}\n}}\n"
         + camera + mirror
     )
 

@@ -119,7 +119,8 @@ TEST_CASE("config: the rig's misalignments in the camera section, bad values nam
                                    "  focal_scale: 1.008\n"
                                    "  mirror_dz_mm: 2.5\n"
                                    "  mirror_tilt_deg: [0.8, -0.5]\n"
-                                   "  mirror_offset_mm: [0.7, -0.4]\n");
+                                   "  mirror_offset_mm: [0.7, -0.4]\n"
+                                   "  level_tilt_deg: [0.8, -0.6]\n");
   const omnislam::mirror::RigConfig rig = omnislam::io::load_config(file).scan.camera.rig;
   CHECK(rig.focal_scale == 1.008);
   CHECK(rig.mirror_dz_mm == 2.5);
@@ -127,7 +128,11 @@ TEST_CASE("config: the rig's misalignments in the camera section, bad values nam
   CHECK(rig.mirror_tilt_y_rad == Approx(-0.5 * 3.14159265358979323846 / 180.0).epsilon(1e-15));
   CHECK(rig.mirror_offset_x_mm == 0.7);
   CHECK(rig.mirror_offset_y_mm == -0.4);
+  CHECK(rig.level_tilt_x_rad == Approx(0.8 * 3.14159265358979323846 / 180.0).epsilon(1e-15));
+  CHECK(rig.level_tilt_y_rad == Approx(-0.6 * 3.14159265358979323846 / 180.0).epsilon(1e-15));
   CHECK_FALSE(rig.nominal());
+  CHECK_FALSE(omnislam::io::load_config(write_file("tilt.yaml", "camera:\n  level_tilt_deg: [0, 0.1]\n"))
+                  .scan.camera.rig.nominal());
   CHECK(omnislam::io::load_config(write_file("norig.yaml", "camera:\n  width: 1024\n"))
             .scan.camera.rig.nominal());
   const std::pair<const char *, const char *> bad[] = {
@@ -137,6 +142,7 @@ TEST_CASE("config: the rig's misalignments in the camera section, bad values nam
       {"camera:\n  mirror_tilt_deg: [0, 90]\n", "camera.mirror_tilt_deg"},
       {"camera:\n  mirror_offset_mm: [0.5, .nan]\n", "camera.mirror_offset_mm"},
       {"camera:\n  mirror_offset: [0.5, 0]\n", "camera.mirror_offset"},
+      {"camera:\n  level_tilt_deg: [6, 0]\n", "camera.level_tilt_deg"},
   };
   for (const auto &[text, key] : bad) {
     CAPTURE(text);

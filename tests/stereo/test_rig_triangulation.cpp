@@ -176,3 +176,43 @@ TEST_CASE("row triangulator: a misaligned rig's stereo point off the floor follo
     }
   }
 }
+
+TEST_CASE("row triangulator: a rig turned off level triangulates floor points from their designed rows",
+          "[stereo][rig]") {
+  // The whole rig (camera and mirror) turned 0.8 / -0.6 deg away from level: without the
+  // tilt a floor point 2 m away reads ~(2 m)^2 x 0.0175 rad / 1 m = 70 mm off per degree.
+  // With it, the panoramas resample the image so that each designed row and column sees
+  // its point of the level floor, and the rays are the level frame's.
+  MirrorConfig config;
+  config.rig.level_tilt_x_rad = 0.8 * std::numbers::pi / 180.0;
+  config.rig.level_tilt_y_rad = -0.6 * std::numbers::pi / 180.0;
+  config.reference_depth_mm = 1000.0;
+  const MirrorModel model(config);
+  const RowTriangulator triangulator(model, TriangulationMethod::kExact);
+  const omnislam::mirror::RigModel rig(config);
+  for (int column : {10, 100, 190, 280}) {
+    for (double range_m : {0.9, 2.0, 3.5}) {
+      const auto inner = model.project_row(Lobe::kInner, {range_m, -1.0});
+      const auto outer = model.project_row(Lobe::kOuter, {range_m, -1.0});
+      REQUIRE(inner);
+      REQUIRE(outer);
+      CAPTURE(column, range_m);
+      const auto point =
+          triangulator.triangulate(column, static_cast<float>(*inner), static_cast<float>(*outer));
+      REQUIRE(point);
+      CHECK(std::abs(point->range_m - range_m) < 3e-5 * range_m * range_m);
+      CHECK(std::abs(point->height_m + 1.0) < 4e-5 * range_m);
+      CHECK(std::abs(point->azimuth_shift_rad) < 1e-5);
+    }
+  }
+  // Rays and projection in the level frame invert each other.
+  const Eigen::Vector3d wall(1.7, -0.9, 0.2);
+  for (const Lobe lobe : {Lobe::kInner, Lobe::kOuter}) {
+    const auto pixel = rig.project(lobe, wall);
+    REQUIRE(pixel);
+    const auto ray = rig.back_project(lobe, *pixel);
+    REQUIRE(ray);
+    const Eigen::Vector3d to_wall = (wall - ray->origin_m).normalized();
+    CHECK((to_wall - ray->direction).norm() < 1e-8);
+  }
+}

@@ -46,6 +46,8 @@ void read_rig_fields(YamlSection &section, mirror::RigConfig &rig) {
             rig.mirror_tilt_y_rad);
   read_pair(section, "mirror_offset_mm", "must be [x, y] in millimetres", 1.0, rig.mirror_offset_x_mm,
             rig.mirror_offset_y_mm);
+  read_pair(section, "level_tilt_deg", "must be [x, y] in degrees", kRad, rig.level_tilt_x_rad,
+            rig.level_tilt_y_rad);
   if (!(rig.focal_scale >= 0.9 && rig.focal_scale <= 1.1))
     section.fail("focal_scale", "must be in [0.9, 1.1]");
   if (!(std::abs(rig.mirror_dz_mm) <= kMaxShiftMm)) section.fail("mirror_dz_mm", "must be within +-10 mm");
@@ -54,6 +56,9 @@ void read_rig_fields(YamlSection &section, mirror::RigConfig &rig) {
     section.fail("mirror_tilt_deg", "each angle must be within +-5 degrees");
   if (!(std::abs(rig.mirror_offset_x_mm) <= kMaxShiftMm && std::abs(rig.mirror_offset_y_mm) <= kMaxShiftMm))
     section.fail("mirror_offset_mm", "each offset must be within +-10 mm");
+  if (!(std::abs(rig.level_tilt_x_rad) <= kMaxTiltDeg * kRad &&
+        std::abs(rig.level_tilt_y_rad) <= kMaxTiltDeg * kRad))
+    section.fail("level_tilt_deg", "each angle must be within +-5 degrees");
 }
 
 }  // namespace

@@ -51,6 +51,9 @@ RigModel::RigModel(const MirrorConfig &config) : design_(config) {
   rotation_ = (Eigen::AngleAxisd(rig.mirror_tilt_y_rad, Eigen::Vector3d::UnitY()) *
                Eigen::AngleAxisd(rig.mirror_tilt_x_rad, Eigen::Vector3d::UnitX()))
                   .toRotationMatrix();
+  level_ = (Eigen::AngleAxisd(rig.level_tilt_y_rad, Eigen::Vector3d::UnitY()) *
+            Eigen::AngleAxisd(rig.level_tilt_x_rad, Eigen::Vector3d::UnitX()))
+               .toRotationMatrix();
   pivot_mm_ = Eigen::Vector3d(0.0, 0.0, design_.constants(Lobe::kInner).focus_z_mm);
   shift_mm_ = Eigen::Vector3d(rig.mirror_offset_x_mm, rig.mirror_offset_y_mm, rig.mirror_dz_mm);
   focal_px_ = rig.focal_scale * config.focal_mm / config.pixel_pitch_mm;
@@ -118,8 +121,8 @@ std::optional<Ray3> RigModel::back_project(Lobe lobe, const Pixel &pixel) const 
   // leaves the mirror point along the reflected camera ray.
   const Eigen::Vector3d reflected = h->ray_dir - 2.0 * h->ray_dir.dot(h->normal) * h->normal;
   Ray3 ray;
-  ray.origin_m = (rotation_ * (h->point_mm - pivot_mm_) + pivot_mm_ + shift_mm_) / kMmPerM;
-  ray.direction = (rotation_ * reflected).normalized();
+  ray.origin_m = level_ * (rotation_ * (h->point_mm - pivot_mm_) + pivot_mm_ + shift_mm_) / kMmPerM;
+  ray.direction = (level_ * (rotation_ * reflected)).normalized();
   return ray;
 }
 
@@ -148,12 +151,13 @@ std::optional<Pixel> RigModel::project(Lobe lobe, const Eigen::Vector3d &point_m
   if (!point_m.allFinite()) return std::nullopt;
   const MirrorConfig &config = design_.config();
   const MirrorModel::LobeConstants &k = design_.constants(lobe);
-  // Start at the designed model's pixel (mirror.md sec. 4).
-  const double range_mm = std::hypot(point_m.x(), point_m.y()) * kMmPerM;
-  const double theta = std::atan2(range_mm - k.focus_r_mm, k.focus_z_mm - point_m.z() * kMmPerM);
+  // Start at the designed model's pixel (mirror.md sec. 4) of the point in the camera frame.
+  const Eigen::Vector3d in_camera = level_.transpose() * point_m;
+  const double range_mm = std::hypot(in_camera.x(), in_camera.y()) * kMmPerM;
+  const double theta = std::atan2(range_mm - k.focus_r_mm, k.focus_z_mm - in_camera.z() * kMmPerM);
   const std::optional<double> radius_px = design_.radius_px_of_theta(lobe, theta);
   if (!radius_px) return std::nullopt;
-  const double phi = std::atan2(point_m.y(), point_m.x());
+  const double phi = std::atan2(in_camera.y(), in_camera.x());
   Eigen::Vector2d uv(config.center_u_px + *radius_px * std::cos(phi),
                      config.center_v_px + *radius_px * std::sin(phi));
   // Residual: the unit direction from the ray's origin to the point minus the ray's

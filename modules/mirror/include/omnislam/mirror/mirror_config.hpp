@@ -37,11 +37,19 @@ struct RigConfig {
   double mirror_tilt_y_rad = 0.0;   ///< then about the camera y axis (right-handed)
   double mirror_offset_x_mm = 0.0;  ///< mirror moved along the camera x axis (image +u)
   double mirror_offset_y_mm = 0.0;  ///< mirror moved along the camera y axis (image +v)
+  /// The whole rig (camera and mirror together) turned about the pinhole away from level:
+  /// about the camera x axis, then the y axis (right-handed), so that its optical axis is off
+  /// the floor's normal (a mount that is not square, a robot that leans). Rays and points
+  /// are then in the level frame (z along the floor's normal, x and y the camera's turned
+  /// back), where the floor is z = -camera height.
+  double level_tilt_x_rad = 0.0;
+  double level_tilt_y_rad = 0.0;
 
   /// True when the rig is exactly as designed (the closed-form model applies).
   [[nodiscard]] bool nominal() const {
     return focal_scale == 1.0 && mirror_dz_mm == 0.0 && mirror_tilt_x_rad == 0.0 &&
-           mirror_tilt_y_rad == 0.0 && mirror_offset_x_mm == 0.0 && mirror_offset_y_mm == 0.0;
+           mirror_tilt_y_rad == 0.0 && mirror_offset_x_mm == 0.0 && mirror_offset_y_mm == 0.0 &&
+           level_tilt_x_rad == 0.0 && level_tilt_y_rad == 0.0;
   }
 };
 

@@ -18,7 +18,9 @@
 /// (point -> pixel) is Gauss-Newton on the pixel, started at the designed model's pixel.
 ///
 /// Frame: the camera frame of mirror.md (origin F0, z up the optical axis), with x along
-/// image +u and y along image +v (architecture.md), in metres. The lobes are taken as
+/// image +u and y along image +v (architecture.md), in metres; for a rig turned off level
+/// (RigConfig::level_tilt_*) rays and points are in the level frame, the camera frame turned
+/// back by that tilt about the pinhole (z along the floor's normal). The lobes are taken as
 /// the analytic surfaces: whether a lobe really covers a pixel is for the caller to judge
 /// (the designed annuli of image radii, or mirror_radius_mm()). All functions are const
 /// and thread-safe.
@@ -94,6 +96,7 @@ class RigModel {
 
   MirrorModel design_;
   Eigen::Matrix3d rotation_;  ///< R: mirror (design) frame -> camera frame
+  Eigen::Matrix3d level_;     ///< camera frame -> level frame (RigConfig::level_tilt_*)
   Eigen::Vector3d pivot_mm_;  ///< the designed inner focus
   Eigen::Vector3d shift_mm_;  ///< (offset_x, offset_y, dz)
   double focal_px_ = 0.0;     ///< true focal length in pixels
