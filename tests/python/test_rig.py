@@ -166,7 +166,7 @@ def test_a_rig_turned_off_level_reads_the_floor_with_its_tilt(tmp_path):
     that is not square). Replayed with camera.level_tilt_deg it is as accurate as the level
     rig; read as level, the floor ranges are off by about r^2/h per radian of tilt and the run
     falls apart. Measured (2026-12-07): with the tilt 6.7 mm max / 2.0 mm map median (the
-    level rig's render 4.9 / 1.7); read as level 145.7 / 36.8 mm."""
+    level rig's render 5.1 / 1.8); read as level 145.7 / 36.8 mm."""
     tilted = REPO / "datasets" / "sim-room-37-level-tilt"
     level = tmp_path / "read-as-level"
     shutil.copytree(tilted, level, ignore=shutil.ignore_patterns("images"))
