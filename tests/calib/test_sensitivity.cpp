@@ -9,7 +9,7 @@
 TEST_CASE("range sensitivity: a centre pixel costs one row of floor range", "[calib][sensitivity]") {
   const omnislam::mirror::MirrorConfig camera;
   const auto rows = omnislam::calib::range_sensitivity(camera, 1.0);
-  REQUIRE(rows.size() == 2);
+  REQUIRE(rows.size() == 3);
   const omnislam::mirror::MirrorModel model(camera);
   const omnislam::stereo::FloorGeometry floor(model, 1.0);
   for (std::size_t i = 0; i < omnislam::calib::kSensitivityRangesM.size(); ++i) {
@@ -31,6 +31,19 @@ TEST_CASE("range sensitivity: a centre pixel costs one row of floor range", "[ca
   // scales both radii and so the disparity, a centre error shifts both alike.
   CHECK(rows[1].floor_plane_m[2] < rows[1].stereo_m[2]);
   CHECK(rows[0].stereo_m[2] < rows[0].floor_plane_m[2]);
+  // A rig turned 0.1 deg off level about the pinhole turns the inner lobe's rays by as much
+  // about its viewpoint, d = 0.2703 m above the pinhole (H = 1.2703 m above the floor), and
+  // moves that viewpoint d x tilt sideways: a floor point r away reads about
+  // tilt x ((r^2 + H^2) / H - d) off along the tilt (docs/calibration.md; 3.1 / 7.2 / 23.6 mm
+  // at 1 / 2 / 4 m). Stereo turns both rays alike: the point turns about the pinhole, its
+  // range moved by h x tilt (1.7 mm) wherever it is.
+  REQUIRE(rows[2].parameter == "level tilt");
+  const double tilt = 0.1 * 3.14159265358979 / 180.0, d = 0.2703, H = 1.0 + d;
+  for (std::size_t i = 0; i < omnislam::calib::kSensitivityRangesM.size(); ++i) {
+    const double range_m = omnislam::calib::kSensitivityRangesM[i];
+    CHECK(rows[2].floor_plane_m[i] == Approx(tilt * ((range_m * range_m + H * H) / H - d)).epsilon(0.05));
+    CHECK(rows[2].stereo_m[i] == Approx(1.0 * tilt).epsilon(0.1));
+  }
 }
 
 TEST_CASE(

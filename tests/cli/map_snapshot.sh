@@ -19,7 +19,9 @@ grep -q "saved $points map points, the occupancy grid, the keyframe graph and th
 last=$(tail -n 1 "$work/run/trajectory.tum")
 x=$(echo "$last" | awk '{ printf "%.4f", $2 }')
 y=$(echo "$last" | awk '{ printf "%.4f", $3 }')
-grep -q "^version: 6$" "$work/info.txt" || fail "info: no version line"
+grep -q "^version: 7$" "$work/info.txt" || fail "info: no version line"
+grep -Eq "^odometry distance factor: [0-9.]+ \+- [0-9.]+ \(learnt" "$work/info.txt" ||
+  fail "info: no odometry distance factor: $(grep factor "$work/info.txt")"
 grep -q "^map points: $points " "$work/info.txt" || fail "info: map points differ from map.csv ($points)"
 grep -q "^pose: x $x m, y $y m, .* t 0.900 s$" "$work/info.txt" || fail "info: pose is not the last of trajectory.tum ($x, $y)"
 grep -Eq "^frames: 10, integrated [0-9]+, not integrated [0-9]+, skipped 0, dropped 0$" "$work/info.txt" ||
@@ -95,7 +97,7 @@ check_bad() {  # source, expected message
 }
 check_bad "$work/absent.snap" ".*/absent.snap: no such file or directory"
 check_bad "$work/run/map.pgm" ".*/run/map.pgm: not an omnislam snapshot (bad magic)"
-check_bad "$work/future.snap" ".*/future.snap: unsupported snapshot version 9 (this build reads versions 1 to 6)"
+check_bad "$work/future.snap" ".*/future.snap: unsupported snapshot version 9 (this build reads versions 1 to 7)"
 check_bad "$work/empty-dir" ".*/empty-dir: no map.yaml (not an omnislam replay or omnislamd output directory)"
 
 "$omnislam" map load "$work/state.snap" --out "$work/loaded" >/dev/null

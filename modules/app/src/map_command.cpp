@@ -92,6 +92,13 @@ void print_info(const std::filesystem::path &file) {
   } else {
     std::printf("keyframe graph: none\n");
   }
+  if (s.odometry_scale) {
+    std::printf(
+        "odometry distance factor: %.4f +- %.4f (learnt; a run resumed or localized on it starts from it)\n",
+        s.odometry_scale->factor, s.odometry_scale->sigma);
+  } else {
+    std::printf("odometry distance factor: none%s\n", s.version < 7 ? " (snapshot version < 7)" : "");
+  }
 }
 
 // The last row of covariance.csv ("frame,t,xx,xy,yy,xyaw,yyaw,yawyaw"), or zero.

@@ -18,6 +18,7 @@ namespace {
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr double kCentreStepPx = 1.0;
 constexpr double kFocalStep = 0.001;  // 0.1%
+constexpr double kLevelTiltStepRad = 0.1 * std::numbers::pi / 180.0;
 
 struct Radii {
   double inner_px = kNaN;
@@ -134,6 +135,19 @@ std::vector<RangeSensitivity> range_sensitivity(const mirror::MirrorConfig &came
   const mirror::MirrorModel rig(longer);
   rows.push_back(row_for("focal length", "0.1%", model, camera_height_m,
                          [&](const mirror::MeridianPoint &point) { return project(rig, point); }));
+  // The whole rig turned 0.1 deg off level about the camera x axis, read as level: a floor
+  // point along the camera y axis (the worst azimuth), imaged by the tilted rig.
+  mirror::MirrorConfig tilted = camera;
+  tilted.rig.level_tilt_x_rad += kLevelTiltStepRad;
+  const mirror::RigModel truth(tilted), read(camera);
+  RangeSensitivity level{"level tilt", "0.1 deg", {}, {}};
+  for (std::size_t i = 0; i < kSensitivityRangesM.size(); ++i) {
+    const double range_m = kSensitivityRangesM[i];
+    const ReadBack back = read_back(truth, read, Eigen::Vector3d(0.0, range_m, -camera_height_m));
+    level.floor_plane_m[i] = std::abs(back.floor_plane_m - range_m);
+    level.stereo_m[i] = std::abs(back.stereo_m - range_m);
+  }
+  rows.push_back(level);
   return rows;
 }
 

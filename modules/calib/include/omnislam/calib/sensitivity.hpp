@@ -25,7 +25,8 @@ struct RangeSensitivity {
 };
 
 /// One row per parameter the mirror model represents (the centre, worst azimuth; the focal
-/// length), for a camera `camera_height_m` above the floor.
+/// length; the whole rig turned off level, worst azimuth), for a camera `camera_height_m`
+/// above the floor.
 [[nodiscard]] std::vector<RangeSensitivity> range_sensitivity(const mirror::MirrorConfig &camera,
                                                               double camera_height_m);
 
