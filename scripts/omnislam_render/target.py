@@ -14,6 +14,7 @@ from dataclasses import dataclass
 
 from . import mirror as M
 from . import pov
+from .scene import level_tilt_transform
 
 CAMERA_HEIGHT_MM = 1000.0
 
@@ -107,11 +108,17 @@ def board_pov(board: Board, view: View) -> str:
 
 def scene(board: Board, view: View, rig: M.Rig) -> str:
     """A plain grey room lit evenly (bright enough for the rim method's steps), the board,
-    the camera and mirror of `rig`."""
+    the camera and mirror of `rig`. The room and the board are placed in the level frame
+    (the floor at z = -camera height), turned into the camera's when the rig is off level
+    (rig.level_tilt_deg)."""
+    world = (
+        f"plane {{ z, {pov.num(-CAMERA_HEIGHT_MM)} pigment {{ rgb 0.45 }} finish {{ ambient 1 diffuse 0 }} }}\n"
+        "sphere { <0,0,0>, 20000 pigment { rgb 0.6 } finish { ambient 1 diffuse 0 } }\n"
+        + board_pov(board, view))
+    if rig.level_tilt_deg != (0.0, 0.0):
+        world = "union {\n" + world + level_tilt_transform(rig.level_tilt_deg) + "\n}\n"
     return (
         "#version 3.7;\n"
         "global_settings { assumed_gamma 1.0 ambient_light rgb 1 max_trace_level 5 }\n"
-        f"plane {{ z, {pov.num(-CAMERA_HEIGHT_MM)} pigment {{ rgb 0.45 }} finish {{ ambient 1 diffuse 0 }} }}\n"
-        "sphere { <0,0,0>, 20000 pigment { rgb 0.6 } finish { ambient 1 diffuse 0 } }\n"
-        + board_pov(board, view) + pov.camera_block(rig) + pov.mirror_block(rig)
+        + world + pov.camera_block(rig) + pov.mirror_block(rig)
     )

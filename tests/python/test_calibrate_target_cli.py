@@ -170,3 +170,17 @@ def test_calibrate_target_bad_input_is_named_and_nothing_written(tmp_path):
     assert result.returncode != 0
     assert "no board lay on the floor" in result.stderr
     assert not out.exists()
+
+
+def test_calibrate_target_keeps_a_configured_level_tilt(tmp_path):
+    """A rig off level (camera.level_tilt_deg, measured by an inclinometer) is not fitted, but
+    the fit is made with it (the boards on the floor lie level in the level frame), so the
+    file written carries it with the rest."""
+    config = tmp_path / "tilt.yaml"
+    config.write_text("camera: {level_tilt_deg: [0.0, 0.1]}\n")
+    out = tmp_path / "target.yaml"
+    result = run("calibrate", "target", *images([1, 3, 5, 7, 10, 14, 18, 22]), "--config", config, "--out", out)
+    assert result.returncode == 0, result.stderr
+    camera = yaml.safe_load(out.read_text())["camera"]
+    assert camera["level_tilt_deg"] == [0.0, 0.1]
+    assert "camera_height_m" in camera

@@ -159,6 +159,12 @@ void write_yaml(const std::string &file, const calib::TargetFitResult &fit) {
                 c.rig.mirror_tilt_x_rad * kDeg, c.rig.mirror_tilt_y_rad * kDeg, c.rig.mirror_offset_x_mm,
                 c.rig.mirror_offset_y_mm);
   out << text;
+  if (c.rig.level_tilt_x_rad != 0.0 || c.rig.level_tilt_y_rad != 0.0) {
+    // Not fitted: the configured tilt the fit was made with (it goes with the rest).
+    std::snprintf(text, sizeof text, ", level_tilt_deg: [%.5f, %.5f]", c.rig.level_tilt_x_rad * kDeg,
+                  c.rig.level_tilt_y_rad * kDeg);
+    out << text;
+  }
   if (std::isfinite(fit.camera_height_m)) {
     std::snprintf(text, sizeof text, ", camera_height_m: %.4f", fit.camera_height_m);
     out << text;
