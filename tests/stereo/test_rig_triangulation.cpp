@@ -15,6 +15,24 @@ using omnislam::mirror::MirrorModel;
 using omnislam::stereo::RowTriangulator;
 using omnislam::stereo::TriangulationMethod;
 
+namespace {
+
+// A floor point `range_m` away (the camera 1 m up) triangulated from its designed rows in
+// panorama column `column`: a misaligned rig's panoramas keep floor points there.
+omnislam::stereo::ColumnPoint floor_point_from_designed_rows(const MirrorModel &model,
+                                                             const RowTriangulator &triangulator, int column,
+                                                             double range_m) {
+  const auto inner = model.project_row(Lobe::kInner, {range_m, -1.0});
+  const auto outer = model.project_row(Lobe::kOuter, {range_m, -1.0});
+  REQUIRE(inner);
+  REQUIRE(outer);
+  const auto point = triangulator.triangulate(column, static_cast<float>(*inner), static_cast<float>(*outer));
+  REQUIRE(point);
+  return *point;
+}
+
+}  // namespace
+
 TEST_CASE("row triangulator: a designed rig's column-aware path is the closed form", "[stereo][rig]") {
   const MirrorModel model;
   for (const TriangulationMethod method : {TriangulationMethod::kExact, TriangulationMethod::kTable}) {
@@ -50,18 +68,12 @@ TEST_CASE("row triangulator: a misaligned rig triangulates floor points from the
   int checked = 0;
   for (int column : {5, 95, 185, 275}) {
     for (double range_m : {0.9, 1.3, 2.0, 3.0}) {
-      const auto inner = model.project_row(Lobe::kInner, {range_m, -1.0});
-      const auto outer = model.project_row(Lobe::kOuter, {range_m, -1.0});
-      REQUIRE(inner);
-      REQUIRE(outer);
-      CAPTURE(column, range_m, *inner, *outer);
-      const auto point =
-          triangulator.triangulate(column, static_cast<float>(*inner), static_cast<float>(*outer));
-      REQUIRE(point);
+      CAPTURE(column, range_m);
+      const auto point = floor_point_from_designed_rows(model, triangulator, column, range_m);
       // float rows, rays linear between the panorama's pixels: measured up to 29 um (8 um
       // with each pixel's image position interpolated and traced; a row is ~10 mm here).
-      CHECK(std::abs(point->range_m - range_m) < 3e-5 * range_m);
-      CHECK(std::abs(point->height_m + 1.0) < 4e-5);
+      CHECK(std::abs(point.range_m - range_m) < 3e-5 * range_m);
+      CHECK(std::abs(point.height_m + 1.0) < 4e-5);
       ++checked;
     }
   }
@@ -192,17 +204,11 @@ TEST_CASE("row triangulator: a rig turned off level triangulates floor points fr
   const omnislam::mirror::RigModel rig(config);
   for (int column : {10, 100, 190, 280}) {
     for (double range_m : {0.9, 2.0, 3.5}) {
-      const auto inner = model.project_row(Lobe::kInner, {range_m, -1.0});
-      const auto outer = model.project_row(Lobe::kOuter, {range_m, -1.0});
-      REQUIRE(inner);
-      REQUIRE(outer);
       CAPTURE(column, range_m);
-      const auto point =
-          triangulator.triangulate(column, static_cast<float>(*inner), static_cast<float>(*outer));
-      REQUIRE(point);
-      CHECK(std::abs(point->range_m - range_m) < 3e-5 * range_m * range_m);
-      CHECK(std::abs(point->height_m + 1.0) < 4e-5 * range_m);
-      CHECK(std::abs(point->azimuth_shift_rad) < 1e-5);
+      const auto point = floor_point_from_designed_rows(model, triangulator, column, range_m);
+      CHECK(std::abs(point.range_m - range_m) < 3e-5 * range_m * range_m);
+      CHECK(std::abs(point.height_m + 1.0) < 4e-5 * range_m);
+      CHECK(std::abs(point.azimuth_shift_rad) < 1e-5);
     }
   }
   // Rays and projection in the level frame invert each other.
