@@ -47,18 +47,27 @@ TEST_CASE("range sensitivity: a centre pixel costs one row of floor range", "[ca
 }
 
 TEST_CASE(
-    "range uncertainty: a focal sigma of 0.1% costs what the sensitivity table says, a centre sigma "
-    "1/sqrt(2) of its worst azimuth",
+    "range uncertainty: a focal sigma of 0.1% costs what the sensitivity table says, a centre or level "
+    "tilt sigma 1/sqrt(2) of its worst azimuth",
     "[calib][sensitivity]") {
   const omnislam::mirror::MirrorConfig camera;
   const auto rows = omnislam::calib::range_sensitivity(camera, 1.0);
-  Eigen::Matrix<double, 8, 8> covariance = Eigen::Matrix<double, 8, 8>::Zero();
+  using Covariance =
+      Eigen::Matrix<double, omnislam::calib::kTargetParameters, omnislam::calib::kTargetParameters>;
+  Covariance covariance = Covariance::Zero();
   covariance(omnislam::calib::kFocalScale, omnislam::calib::kFocalScale) = 1e-6;  // sigma 0.1%
   const auto focal = omnislam::calib::range_uncertainty(camera, covariance, 1.0);
   covariance.setZero();
   covariance(omnislam::calib::kCenterU, omnislam::calib::kCenterU) = 1.0;  // sigma 1 px
   const auto centre = omnislam::calib::range_uncertainty(camera, covariance, 1.0);
+  covariance.setZero();
+  const double tilt_rad = 0.1 * 3.14159265358979 / 180.0;
+  covariance(omnislam::calib::kLevelX, omnislam::calib::kLevelX) = tilt_rad * tilt_rad;  // sigma 0.1 deg
+  const auto level = omnislam::calib::range_uncertainty(camera, covariance, 1.0);
   for (std::size_t i = 0; i < 3; ++i) {
+    CAPTURE(i, level.floor_plane_m[i], level.stereo_m[i]);
+    CHECK(level.floor_plane_m[i] == Approx(rows[2].floor_plane_m[i] / std::sqrt(2.0)).epsilon(0.15));
+    CHECK(level.stereo_m[i] == Approx(rows[2].stereo_m[i] / std::sqrt(2.0)).epsilon(0.15));
     CAPTURE(i, focal.floor_plane_m[i], focal.stereo_m[i], centre.floor_plane_m[i], centre.stereo_m[i]);
     CHECK(focal.floor_plane_m[i] == Approx(rows[1].floor_plane_m[i]).epsilon(0.1));
     CHECK(focal.stereo_m[i] == Approx(rows[1].stereo_m[i]).epsilon(0.1));

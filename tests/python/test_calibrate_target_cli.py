@@ -49,7 +49,10 @@ def test_calibrate_target_recovers_a_misaligned_rig(calibrated):
     for name in ("centre u", "focal scale", "mirror dz", "mirror tilt x", "mirror offset y", "camera height"):
         assert f"| {name} |" in result.stdout
     assert "range error these uncertainties imply" in result.stdout
+    # The rig is square to the floor: the boards show no level tilt worth fitting.
+    assert re.search(r"level tilt: fitting it takes \d+\.\d off the chi-square \(held", result.stdout)
     camera = yaml.safe_load(out.read_text())["camera"]
+    assert "level_tilt_deg" not in camera
     # Measured (see docs/calibration.md): focal 0.035%, mirror distance 0.22 mm = 0.08% of
     # the 270.3 mm to the inner focus, tilt 0.008 / 0.011 deg: the issue's 0.05%, 0.1% and
     # 0.05 deg hold and are asserted. The centre is 0.7 / 0.46 px off (sigma 0.7: the issue's
@@ -173,14 +176,16 @@ def test_calibrate_target_bad_input_is_named_and_nothing_written(tmp_path):
 
 
 def test_calibrate_target_keeps_a_configured_level_tilt(tmp_path):
-    """A rig off level (camera.level_tilt_deg, measured by an inclinometer) is not fitted, but
-    the fit is made with it (the boards on the floor lie level in the level frame), so the
-    file written carries it with the rest."""
+    """A rig off level by a measured amount (camera.level_tilt_deg, an inclinometer) with
+    --hold-level: the tilt is not fitted, the fit is made with it (the boards on the floor
+    lie level in the level frame), and the file written carries it with the rest."""
     config = tmp_path / "tilt.yaml"
     config.write_text("camera: {level_tilt_deg: [0.0, 0.1]}\n")
     out = tmp_path / "target.yaml"
-    result = run("calibrate", "target", *images([1, 3, 5, 7, 10, 14, 18, 22]), "--config", config, "--out", out)
+    result = run("calibrate", "target", *images([1, 3, 5, 7, 10, 14, 18, 22]), "--config", config, "--hold-level",
+                 "--out", out)
     assert result.returncode == 0, result.stderr
+    assert re.search(r"\| level tilt y \| 0\.1000 deg \| 0\.0000 deg \(held\) \|", result.stdout)
     camera = yaml.safe_load(out.read_text())["camera"]
     assert camera["level_tilt_deg"] == [0.0, 0.1]
     assert "camera_height_m" in camera

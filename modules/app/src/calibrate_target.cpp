@@ -28,6 +28,7 @@ struct TargetOptions {
   std::string config;
   std::string squares = "8x6";
   double square_mm = 45.0;
+  bool hold_level = false;
   std::string out;
 };
 
@@ -121,8 +122,16 @@ void print_report(const calib::TargetFitResult &fit, const Detected &detected, c
               s[calib::kTiltY] * kDeg);
   std::printf("| mirror offset x | %.3f mm | %.3f mm |\n| mirror offset y | %.3f mm | %.3f mm |\n",
               c.rig.mirror_offset_x_mm, s[calib::kOffsetX], c.rig.mirror_offset_y_mm, s[calib::kOffsetY]);
+  const char *held = fit.level_fitted ? "" : " (held)";
+  std::printf("| level tilt x | %.4f deg | %.4f deg%s |\n| level tilt y | %.4f deg | %.4f deg%s |\n",
+              c.rig.level_tilt_x_rad * kDeg, s[calib::kLevelX] * kDeg, held, c.rig.level_tilt_y_rad * kDeg,
+              s[calib::kLevelY] * kDeg, held);
   if (std::isfinite(fit.camera_height_m))
     std::printf("| camera height | %.4f m | %.4f m |\n", fit.camera_height_m, fit.camera_height_sigma_m);
+  if (std::isfinite(fit.level_chi2)) {
+    std::printf("level tilt: fitting it takes %.1f off the chi-square (%s, Akaike: 4 for its 2 parameters)\n",
+                fit.level_chi2, fit.level_fitted ? "fitted" : "held at the configured tilt");
+  }
   const calib::RangeUncertainty range =
       calib::range_uncertainty(fit.camera, fit.covariance, config.scan.camera_height_m);
   std::printf(
@@ -140,10 +149,11 @@ void write_yaml(const std::string &file, const calib::TargetFitResult &fit) {
   std::snprintf(
       text, sizeof text,
       "# omnislam calibrate target: %d views, %d corners, rms %.3f px; 1 sigma: centre %.3f %.3f px, "
-      "focal_scale %.5f, mirror_dz_mm %.3f, tilt %.4f %.4f deg, offset %.3f %.3f mm\n",
+      "focal_scale %.5f, mirror_dz_mm %.3f, tilt %.4f %.4f deg, offset %.3f %.3f mm, level tilt %.4f %.4f "
+      "deg\n",
       fit.views_used, fit.corners, fit.rms_px, s[calib::kCenterU], s[calib::kCenterV], s[calib::kFocalScale],
       s[calib::kMirrorDz], s[calib::kTiltX] * kDeg, s[calib::kTiltY] * kDeg, s[calib::kOffsetX],
-      s[calib::kOffsetY]);
+      s[calib::kOffsetY], s[calib::kLevelX] * kDeg, s[calib::kLevelY] * kDeg);
   out << text;
   if (std::isfinite(fit.camera_height_m)) {
     std::snprintf(text, sizeof text,
@@ -160,7 +170,8 @@ void write_yaml(const std::string &file, const calib::TargetFitResult &fit) {
                 c.rig.mirror_offset_y_mm);
   out << text;
   if (c.rig.level_tilt_x_rad != 0.0 || c.rig.level_tilt_y_rad != 0.0) {
-    // Not fitted: the configured tilt the fit was made with (it goes with the rest).
+    // Fitted from the boards on the floor, or (--hold-level) the configured one the fit was
+    // made with: either way it goes with the rest.
     std::snprintf(text, sizeof text, ", level_tilt_deg: [%.5f, %.5f]", c.rig.level_tilt_x_rad * kDeg,
                   c.rig.level_tilt_y_rad * kDeg);
     out << text;
@@ -186,6 +197,7 @@ void run_target(const TargetOptions &options) {
   }
   calib::TargetFitConfig fit_config;
   fit_config.floor_height_m = config.scan.camera_height_m;
+  fit_config.fit_level = !options.hold_level;
   const calib::TargetFitResult fit =
       calib::fit_target(camera, target, detected.views, detected.rim, fit_config);
   if (!fit.converged || !std::isfinite(fit.sigma[calib::kCenterU])) {
@@ -215,6 +227,10 @@ void add_calibrate_target(CLI::App &calibrate) {
   command->add_option("--squares", options->squares, "squares across and down the board (default 8x6)");
   command->add_option("--square-mm", options->square_mm,
                       "side of a square as printed, measured (default 45)");
+  command->add_flag(
+      "--hold-level", options->hold_level,
+      "keep the configured camera.level_tilt_deg (e.g. from an inclinometer) instead of fitting it "
+      "from the boards on the floor");
   command->add_option("--out", options->out, "YAML file to write (camera: centre and rig keys)")->required();
   command->callback([options] { run_target(*options); });
 }

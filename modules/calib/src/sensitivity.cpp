@@ -51,7 +51,8 @@ Radii project(const mirror::MirrorModel &model, const mirror::MeridianPoint &poi
 
 constexpr int kAzimuths = 8;
 // Steps of the derivatives: a tenth of each parameter's unit of about a pixel's effect.
-constexpr std::array<double, kRigParameters> kRangeSteps{0.1, 0.1, 1e-4, 0.1, 1e-4, 1e-4, 0.1, 0.1};
+constexpr std::array<double, kTargetParameters> kRangeSteps{0.1,  0.1, 1e-4, 0.1,  1e-4,
+                                                            1e-4, 0.1, 0.1,  1e-4, 1e-4};
 
 // Horizontal ranges read back with `read` from the pixels at which `truth` images `point`.
 struct ReadBack {
@@ -78,25 +79,28 @@ ReadBack read_back(const mirror::RigModel &truth, const mirror::RigModel &read,
 }
 
 mirror::MirrorConfig stepped(mirror::MirrorConfig config, int parameter, double step) {
-  double *values[kRigParameters] = {&config.center_u_px,
-                                    &config.center_v_px,
-                                    &config.rig.focal_scale,
-                                    &config.rig.mirror_dz_mm,
-                                    &config.rig.mirror_tilt_x_rad,
-                                    &config.rig.mirror_tilt_y_rad,
-                                    &config.rig.mirror_offset_x_mm,
-                                    &config.rig.mirror_offset_y_mm};
+  double *values[kTargetParameters] = {&config.center_u_px,
+                                       &config.center_v_px,
+                                       &config.rig.focal_scale,
+                                       &config.rig.mirror_dz_mm,
+                                       &config.rig.mirror_tilt_x_rad,
+                                       &config.rig.mirror_tilt_y_rad,
+                                       &config.rig.mirror_offset_x_mm,
+                                       &config.rig.mirror_offset_y_mm,
+                                       &config.rig.level_tilt_x_rad,
+                                       &config.rig.level_tilt_y_rad};
   *values[parameter] += step;
   return config;
 }
 
 }  // namespace
 
-RangeUncertainty range_uncertainty(const mirror::MirrorConfig &camera,
-                                   const Eigen::Matrix<double, 8, 8> &covariance, double camera_height_m) {
+RangeUncertainty range_uncertainty(
+    const mirror::MirrorConfig &camera,
+    const Eigen::Matrix<double, kTargetParameters, kTargetParameters> &covariance, double camera_height_m) {
   const mirror::RigModel read(camera);
   std::vector<mirror::RigModel> perturbed;
-  for (int i = 0; i < kRigParameters; ++i) perturbed.emplace_back(stepped(camera, i, kRangeSteps[i]));
+  for (int i = 0; i < kTargetParameters; ++i) perturbed.emplace_back(stepped(camera, i, kRangeSteps[i]));
   RangeUncertainty out;
   for (std::size_t r = 0; r < kSensitivityRangesM.size(); ++r) {
     double floor_sum = 0.0, stereo_sum = 0.0;
@@ -105,8 +109,8 @@ RangeUncertainty range_uncertainty(const mirror::MirrorConfig &camera,
       const Eigen::Vector3d point(kSensitivityRangesM[r] * std::cos(phi),
                                   kSensitivityRangesM[r] * std::sin(phi), -camera_height_m);
       const ReadBack base = read_back(read, read, point);
-      Eigen::Matrix<double, 1, kRigParameters> d_floor, d_stereo;
-      for (int i = 0; i < kRigParameters; ++i) {
+      Eigen::Matrix<double, 1, kTargetParameters> d_floor, d_stereo;
+      for (int i = 0; i < kTargetParameters; ++i) {
         const ReadBack moved = read_back(perturbed[static_cast<std::size_t>(i)], read, point);
         d_floor(i) = (moved.floor_plane_m - base.floor_plane_m) / kRangeSteps[i];
         d_stereo(i) = (moved.stereo_m - base.stereo_m) / kRangeSteps[i];

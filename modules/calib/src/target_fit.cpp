@@ -30,6 +30,15 @@ const std::vector<double> kRigSteps(kRigParameters, 1e-3);
 const std::vector<double> kPoseSteps(6, 1e-6);
 const std::vector<double> kPlaneSteps(3, 1e-6);
 const std::vector<double> kHeightSteps(1, 1e-6);
+const std::vector<double> kLevelSteps(2, 1e-3);  // microradians (the block is in mrad)
+
+// The rig's level tilt block (mrad, RigConfig::level_tilt_*) as the rotation taking camera
+// coordinates to level ones (as RigModel builds it).
+Eigen::Matrix3d level_rotation(const double *level_mrad) {
+  return (Eigen::AngleAxisd(level_mrad[1] * 1e-3, Eigen::Vector3d::UnitY()) *
+          Eigen::AngleAxisd(level_mrad[0] * 1e-3, Eigen::Vector3d::UnitX()))
+      .toRotationMatrix();
+}
 
 // Where a board point is in the camera frame, from the pose's parameter blocks.
 using Placement =
@@ -62,11 +71,14 @@ ceres::CostFunction *held_corner_cost(const mirror::MirrorConfig &base, const Ta
                      });
 }
 
+// A board on the floor: placed in the level frame (the floor is z = floor_z there), then
+// turned into the camera frame by the rig's level tilt (the last block).
 ceres::CostFunction *floor_corner_cost(const mirror::MirrorConfig &base, const TargetGeometry &target,
                                        const TargetCorner &corner, const double *weight, bool face_up) {
-  return corner_cost(base, target, corner, weight, {kPlaneSteps, kHeightSteps},
+  return corner_cost(base, target, corner, weight, {kPlaneSteps, kHeightSteps, kLevelSteps},
                      [face_up](const double *const *pose, const Eigen::Vector3d &board_m) {
-                       return detail::floor_to_camera(pose[0], pose[1][0], face_up, board_m);
+                       return Eigen::Vector3d(level_rotation(pose[2]).transpose() *
+                                              detail::floor_to_camera(pose[0], pose[1][0], face_up, board_m));
                      });
 }
 
@@ -123,9 +135,12 @@ struct PlacedView {
   std::vector<TargetCorner> corners;
 };
 
-// The joint problem: the rig, every pose, the floor's height, the rim circles.
+// The joint problem: the rig (its level tilt apart), every pose, the floor's height, the
+// rim circles.
 struct JointProblem {
   std::array<double, kRigParameters> rig{};
+  std::array<double, 2> level_mrad{};  // the rig's level tilt; its boards on the floor fix it
+  bool fit_level = true;
   std::vector<PlacedView> views;
   double floor_z_m = kNaN;
   double weight = 1.0;
@@ -135,7 +150,8 @@ struct JointProblem {
   int rim_blocks = 0;
 
   [[nodiscard]] int unknowns() const {
-    int count = kRigParameters + (std::isnan(floor_z_m) ? 0 : 1);
+    const bool floor = !std::isnan(floor_z_m);
+    int count = kRigParameters + (floor ? 1 : 0) + (floor && fit_level ? 2 : 0);
     for (const PlacedView &view : views) count += view.on_floor ? 3 : 6;
     return count;
   }
@@ -155,7 +171,7 @@ void build(JointProblem &joint, const mirror::MirrorConfig &base, const TargetGe
           view.on_floor
               ? joint.problem->AddResidualBlock(
                     floor_corner_cost(base, target, corner, &joint.weight, view.face_up), nullptr,
-                    joint.rig.data(), view.pose.data(), &joint.floor_z_m)
+                    joint.rig.data(), view.pose.data(), &joint.floor_z_m, joint.level_mrad.data())
               : joint.problem->AddResidualBlock(held_corner_cost(base, target, corner, &joint.weight),
                                                 nullptr, joint.rig.data(), view.pose.data());
       joint.corner_blocks.push_back(block);
@@ -171,6 +187,8 @@ void build(JointProblem &joint, const mirror::MirrorConfig &base, const TargetGe
   };
   add_rim(rim.rim, true);
   add_rim(rim.central, false);
+  if (!joint.fit_level && joint.problem->HasParameterBlock(joint.level_mrad.data()))
+    joint.problem->SetParameterBlockConstant(joint.level_mrad.data());
 }
 
 // Each corner's reprojection error in pixels (NaN where it does not project), in the
@@ -206,12 +224,44 @@ double rim_residual_rms(const JointProblem &joint) {
   return std::sqrt(sum / (2.0 * joint.rim_blocks));
 }
 
-bool solve(JointProblem &joint, int max_iterations, TargetFitResult &result) {
+bool solve(JointProblem &joint, int max_iterations, TargetFitResult &result, double *cost = nullptr) {
   ceres::Solver::Summary summary;
   ceres::Solve(solver_options(max_iterations), joint.problem.get(), &summary);
   result.iterations += static_cast<int>(summary.iterations.size());
   result.message = summary.BriefReport();
+  if (cost != nullptr) *cost = summary.final_cost;
   return summary.termination_type == ceres::CONVERGENCE;
+}
+
+// Whether the level tilt the boards on the floor show is worth its two parameters: the fit
+// with it free against the fit with it held at the configured value, by Akaike's criterion
+// (chi-square down by more than 2 per parameter). A rig that is level within what the
+// boards can tell gets the configured tilt instead of a noisy estimate of it: the tilt is
+// nearly interchangeable with the image centre (the file's note), so a free tilt costs
+// range accuracy when there is none to find. Keeps the better of the two in `joint`.
+void choose_level(JointProblem &joint, const mirror::MirrorConfig &base, const TargetGeometry &target,
+                  const RimCircles &rim, const TargetFitConfig &config,
+                  const std::array<double, 2> &configured, double free_cost, TargetFitResult &result) {
+  const std::array<double, kRigParameters> rig = joint.rig;
+  const std::array<double, 2> level = joint.level_mrad;
+  const std::vector<PlacedView> views = joint.views;
+  const double floor_z_m = joint.floor_z_m;
+  const std::string message = result.message;
+  joint.level_mrad = configured;
+  joint.fit_level = false;
+  build(joint, base, target, rim, config);
+  double held_cost = 0.0;
+  const bool converged = solve(joint, config.max_iterations, result, &held_cost);
+  // Ceres's cost is half the sum of squares, the residuals are in their sigmas.
+  result.level_chi2 = 2.0 * (held_cost - free_cost);
+  if (converged && result.level_chi2 <= 2.0 * 2.0) return;
+  joint.rig = rig;
+  joint.level_mrad = level;
+  joint.views = views;
+  joint.floor_z_m = floor_z_m;
+  joint.fit_level = true;
+  build(joint, base, target, rim, config);
+  result.message = message;
 }
 
 // The rig's (and the floor's) standard deviations: every residual is in its own standard
@@ -224,13 +274,34 @@ bool covariance_of(JointProblem &joint, TargetFitResult &result) {
   ceres::Covariance covariance(options);
   std::vector<std::pair<const double *, const double *>> blocks{{joint.rig.data(), joint.rig.data()}};
   const bool floor = !std::isnan(joint.floor_z_m);
+  const bool level = floor && joint.fit_level;
   if (floor) blocks.emplace_back(&joint.floor_z_m, &joint.floor_z_m);
+  if (level) {
+    blocks.emplace_back(joint.level_mrad.data(), joint.level_mrad.data());
+    blocks.emplace_back(joint.rig.data(), joint.level_mrad.data());
+  }
   if (!covariance.Compute(blocks, joint.problem.get())) return false;
-  Eigen::Matrix<double, kRigParameters, kRigParameters, Eigen::RowMajor> c;
-  covariance.GetCovarianceBlock(joint.rig.data(), joint.rig.data(), c.data());
-  for (int i = 0; i < kRigParameters; ++i) {
-    result.sigma[i] = std::sqrt(c(i, i)) * kUnit[i];
-    for (int j = 0; j < kRigParameters; ++j) result.covariance(i, j) = c(i, j) * kUnit[i] * kUnit[j];
+  // Units of the joint covariance: the rig's (kUnit), then the level tilt's mrad.
+  Eigen::Matrix<double, kTargetParameters, kTargetParameters> c =
+      Eigen::Matrix<double, kTargetParameters, kTargetParameters>::Zero();
+  Eigen::Matrix<double, kRigParameters, kRigParameters, Eigen::RowMajor> rig;
+  covariance.GetCovarianceBlock(joint.rig.data(), joint.rig.data(), rig.data());
+  c.topLeftCorner<kRigParameters, kRigParameters>() = rig;
+  if (level) {
+    Eigen::Matrix<double, 2, 2, Eigen::RowMajor> tilt;
+    Eigen::Matrix<double, kRigParameters, 2, Eigen::RowMajor> cross;
+    covariance.GetCovarianceBlock(joint.level_mrad.data(), joint.level_mrad.data(), tilt.data());
+    covariance.GetCovarianceBlock(joint.rig.data(), joint.level_mrad.data(), cross.data());
+    c.bottomRightCorner<2, 2>() = tilt;
+    c.topRightCorner<kRigParameters, 2>() = cross;
+    c.bottomLeftCorner<2, kRigParameters>() = cross.transpose();
+  }
+  std::array<double, kTargetParameters> unit{};
+  std::copy(kUnit.begin(), kUnit.end(), unit.begin());
+  unit[kLevelX] = unit[kLevelY] = 1e-3;
+  for (int i = 0; i < kTargetParameters; ++i) {
+    result.sigma[i] = (i < kRigParameters || level) ? std::sqrt(c(i, i)) * unit[i] : 0.0;
+    for (int j = 0; j < kTargetParameters; ++j) result.covariance(i, j) = c(i, j) * unit[i] * unit[j];
   }
   if (floor) {
     double variance = 0.0;
@@ -247,7 +318,7 @@ void lay_on_floor(JointProblem &joint, const std::vector<bool> &lay) {
   for (std::size_t v = 0; v < joint.views.size(); ++v) {
     PlacedView &view = joint.views[v];
     if (!lay[v] || view.on_floor) continue;
-    const Eigen::Isometry3d T = detail::isometry_of(view.pose);
+    const Eigen::Isometry3d T = level_rotation(joint.level_mrad.data()) * detail::isometry_of(view.pose);
     view.on_floor = true;
     view.face_up = T.linear()(2, 2) > 0.0;
     view.pose = {std::atan2(T.linear()(1, 0), T.linear()(0, 0)),
@@ -269,7 +340,8 @@ std::vector<bool> found_on_floor(const JointProblem &joint, const TargetFitConfi
   std::vector<bool> lay(joint.views.size(), false);
   for (std::size_t v = 0; v < joint.views.size(); ++v) {
     if (joint.views[v].on_floor) continue;
-    const Eigen::Isometry3d T = detail::isometry_of(joint.views[v].pose);
+    const Eigen::Isometry3d T =
+        level_rotation(joint.level_mrad.data()) * detail::isometry_of(joint.views[v].pose);
     const bool level =
         std::abs(T.linear()(2, 2)) > std::cos(config.floor_level_deg * std::numbers::pi / 180.0);
     lay[v] = level && std::abs(T.translation().z() + config.floor_height_m) < config.floor_tolerance_m;
@@ -315,14 +387,18 @@ int drop_outliers(JointProblem &joint, double outlier_px) {
 
 void fill_result(const JointProblem &joint, const mirror::MirrorConfig &initial, TargetFitResult &result) {
   result.camera = apply(initial, joint.rig.data());
+  result.camera.rig.level_tilt_x_rad = joint.level_mrad[0] * 1e-3;
+  result.camera.rig.level_tilt_y_rad = joint.level_mrad[1] * 1e-3;
   result.rms_px = std::sqrt(sum_of_squares(corner_errors_px(joint)) / (2.0 * result.corners));
   result.rim_rms_sigma = rim_residual_rms(joint);
   result.camera_height_m = -joint.floor_z_m;
   for (const PlacedView &view : joint.views) {
     result.on_floor.push_back(view.on_floor);
     result.T_camera_board.push_back(
-        view.on_floor ? detail::floor_isometry(view.pose.data(), joint.floor_z_m, view.face_up)
-                      : detail::isometry_of(view.pose));
+        view.on_floor
+            ? Eigen::Isometry3d(level_rotation(joint.level_mrad.data()).transpose() *
+                                detail::floor_isometry(view.pose.data(), joint.floor_z_m, view.face_up))
+            : detail::isometry_of(view.pose));
   }
 }
 
@@ -340,14 +416,21 @@ TargetFitResult fit_target(const mirror::MirrorConfig &initial, const TargetGeom
   result.sigma.fill(kNaN);
   JointProblem joint;
   joint.rig = parameters_of(initial);
-  start_views(joint, initial, target, views, config, result);
+  joint.level_mrad = {initial.rig.level_tilt_x_rad * 1e3, initial.rig.level_tilt_y_rad * 1e3};
+  joint.fit_level = config.fit_level;
+  // Inside the fit the rig projects from its own (camera) frame: boards held anywhere are
+  // placed there, boards on the floor are turned into it by the level block.
+  mirror::MirrorConfig camera_frame = initial;
+  camera_frame.rig.level_tilt_x_rad = camera_frame.rig.level_tilt_y_rad = 0.0;
+  const mirror::MirrorConfig &base = camera_frame;
+  start_views(joint, base, target, views, config, result);
   result.views_used = static_cast<int>(joint.views.size());
   if (result.views_used < 2) {
     result.message = "too few usable views: " + std::to_string(result.views_used) + " of " +
                      std::to_string(views.size()) + ", need 2";
     return result;
   }
-  build(joint, initial, target, rim, config);
+  build(joint, base, target, rim, config);
   solve(joint, config.max_iterations, result);
   // The boards found lying on the floor (their first poses, from the configured rig, are
   // too rough to tell) become boards on the floor.
@@ -355,13 +438,13 @@ TargetFitResult fit_target(const mirror::MirrorConfig &initial, const TargetGeom
     const std::vector<bool> lay = found_on_floor(joint, config);
     if (std::find(lay.begin(), lay.end(), true) != lay.end()) {
       lay_on_floor(joint, lay);
-      build(joint, initial, target, rim, config);
+      build(joint, base, target, rim, config);
       solve(joint, config.max_iterations, result);
     }
   }
   // Drop the corners that do not fit (a corner on the wrong square) and fit again.
   result.outliers = drop_outliers(joint, config.outlier_px);
-  build(joint, initial, target, rim, config);
+  build(joint, base, target, rim, config);
   result.corners = static_cast<int>(joint.corner_blocks.size());
   if (2 * result.corners <= joint.unknowns()) {
     result.message = "too few corners: " + std::to_string(result.corners);
@@ -372,8 +455,14 @@ TargetFitResult fit_target(const mirror::MirrorConfig &initial, const TargetGeom
   const double corner_sigma_px =
       std::sqrt(sum_of_squares(corner_errors_px(joint)) / (2.0 * result.corners - joint.unknowns()));
   joint.weight = 1.0 / std::max(corner_sigma_px, 1e-6);
-  result.converged = solve(joint, config.max_iterations, result);
-  fill_result(joint, initial, result);
+  double cost = 0.0;
+  result.converged = solve(joint, config.max_iterations, result, &cost);
+  if (result.converged && joint.fit_level && !std::isnan(joint.floor_z_m)) {
+    choose_level(joint, base, target, rim, config,
+                 {initial.rig.level_tilt_x_rad * 1e3, initial.rig.level_tilt_y_rad * 1e3}, cost, result);
+  }
+  result.level_fitted = joint.fit_level && !std::isnan(joint.floor_z_m);
+  fill_result(joint, base, result);
   if (result.converged && !covariance_of(joint, result))
     result.message += "; covariance: not estimable (degenerate views)";
   return result;

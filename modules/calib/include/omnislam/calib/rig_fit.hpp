@@ -40,6 +40,11 @@ enum RigParameter {
   kRigParameters
 };
 
+/// The target fit's parameters (target_fit.hpp): the rig's, then the whole rig's level tilt
+/// (RigConfig::level_tilt_*, rad), which boards lying on the floor fix (their plane's
+/// normal in the camera frame). Known points in the camera frame (fit_rig) say nothing of it.
+enum TargetParameter { kLevelX = kRigParameters, kLevelY, kTargetParameters };
+
 struct RigFitResult {
   bool converged = false;
   int iterations = 0;

@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "omnislam/calib/rig_fit.hpp"
 #include "omnislam/mirror/mirror_config.hpp"
 
 /// @file
@@ -32,7 +33,8 @@ struct RangeSensitivity {
 
 /// The range error (1 sigma) that an uncertain rig implies for a wall's base on the floor
 /// at kSensitivityRangesM: `camera` is the rig as fitted, `covariance` its parameters'
-/// (RigParameter order and units: px, px, 1, mm, rad, rad, mm, mm). The derivative of the
+/// (RigParameter order and units: px, px, 1, mm, rad, rad, mm, mm; then the level tilt's x
+/// and y, rad: zero rows and columns where it was not fitted). The derivative of the
 /// range read back with `camera` from where a rig off by each parameter images the point
 /// (general rig model) is propagated through the covariance, so correlated errors that
 /// cancel in the image cancel here too; RMS over eight azimuths.
@@ -40,8 +42,8 @@ struct RangeUncertainty {
   std::array<double, 3> floor_plane_m{};  ///< the inner lobe's ray met with the floor
   std::array<double, 3> stereo_m{};       ///< the two lobes' rays triangulated
 };
-[[nodiscard]] RangeUncertainty range_uncertainty(const mirror::MirrorConfig &camera,
-                                                 const Eigen::Matrix<double, 8, 8> &covariance,
-                                                 double camera_height_m);
+[[nodiscard]] RangeUncertainty range_uncertainty(
+    const mirror::MirrorConfig &camera,
+    const Eigen::Matrix<double, kTargetParameters, kTargetParameters> &covariance, double camera_height_m);
 
 }  // namespace omnislam::calib

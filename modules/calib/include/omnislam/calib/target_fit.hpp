@@ -25,10 +25,13 @@
 /// pose turned. Boards of unknown pose cannot tell the two apart, nor can the rim circles
 /// (seen directly through the same camera, they turn with the mirror); only the pinhole
 /// camera's perspective (second order, (512 / 3561)^2 = 2% at the rim) separates them, and
-/// weakly (measured: centre sigma ~5 px from 12 held boards and the rim). The model itself
-/// assumes the camera axis perpendicular to the floor (camera_height_m, the floor-plane
-/// range), so a sheet lying on the floor has its normal along the camera axis: boards on
-/// the floor (TargetView::on_floor) fix that rotation and with it the centre the ranges need.
+/// weakly (measured: centre sigma ~5 px from 12 held boards and the rim). Boards on the floor
+/// (TargetView::on_floor) lie on one plane, level in the level frame: its normal in the
+/// camera frame is the rig's level tilt (RigConfig::level_tilt_*). Held at the configured
+/// tilt, they fix the rotation and with it the centre (sigma ~1 px); fitted, the tilt takes
+/// the rotation's place (sigma ~0.07 deg, the centre's ~5 px again) and the floor ranges,
+/// which depend on the two together, stay as well determined. The fit keeps the tilt where
+/// the boards show one (Akaike's criterion), else holds the configured one.
 /// The rim circles (rim.hpp), when given, enter the same problem as residuals in units of
 /// their standard deviation; they constrain the mirror's tilt and offset a little more.
 
@@ -58,9 +61,9 @@ struct TargetCorner {
 /// What one image shows of the board (one pose).
 struct TargetView {
   std::vector<TargetCorner> corners;
-  /// The board lies on the floor: its normal is the camera axis (the model's assumption:
-  /// the camera looks straight up, the robot stands on a flat floor) and all boards on the
-  /// floor share its height. This is what fixes the image centre (see the file's note).
+  /// The board lies on the floor: its normal is the level frame's axis (the robot stands on
+  /// a flat floor; the rig's level tilt turns it into the camera frame) and all boards on
+  /// the floor share its height and tilt (see the file's note).
   bool on_floor = false;
 };
 
@@ -89,6 +92,11 @@ struct TargetFitConfig {
   double floor_height_m = std::numeric_limits<double>::quiet_NaN();
   double floor_level_deg = 10.0;
   double floor_tolerance_m = 0.15;
+  /// Fit the rig's level tilt (the floor's normal in the camera frame, from the boards on
+  /// it) when the boards show one (Akaike's criterion against the initial config's tilt,
+  /// TargetFitResult::level_chi2); when false, the initial config's tilt is held (e.g. from
+  /// an inclinometer).
+  bool fit_level = true;
 };
 
 struct TargetFitResult {
@@ -105,13 +113,21 @@ struct TargetFitResult {
   double camera_height_m =
       std::numeric_limits<double>::quiet_NaN();  ///< pinhole above the floor (boards on it)
   double camera_height_sigma_m = std::numeric_limits<double>::quiet_NaN();
-  std::array<double, kRigParameters> sigma{};     ///< as RigFitResult::sigma
+  /// The level tilt was fitted (false: held at the initial config's, by request or because
+  /// the boards did not show it); `level_chi2` is what fitting it took off the chi-square
+  /// (kept when above 4, 2 per parameter; NaN when not tried).
+  bool level_fitted = false;
+  double level_chi2 = std::numeric_limits<double>::quiet_NaN();
+  /// As RigFitResult::sigma, then the level tilt's (rad; 0 when held, NaN when no board lay
+  /// on the floor).
+  std::array<double, kTargetParameters> sigma{};
   std::vector<Eigen::Isometry3d> T_camera_board;  ///< per used view (metres)
   std::vector<int> used_views;                    ///< their indices into the views given
   std::vector<bool> on_floor;                     ///< per used view: fitted as lying on the floor
-  /// Covariance of the parameters (RigParameter order, the units of `sigma`).
-  Eigen::Matrix<double, kRigParameters, kRigParameters> covariance =
-      Eigen::Matrix<double, kRigParameters, kRigParameters>::Constant(
+  /// Covariance of the parameters (TargetParameter order: RigParameter, then kLevelX, kLevelY, the units of
+  /// `sigma`).
+  Eigen::Matrix<double, kTargetParameters, kTargetParameters> covariance =
+      Eigen::Matrix<double, kTargetParameters, kTargetParameters>::Constant(
           std::numeric_limits<double>::quiet_NaN());
   std::string message;
 };
