@@ -140,7 +140,7 @@ std::array<double, omnislam::calib::kRigParameters> errors_of(const TargetFitRes
 // 6 boards on the floor 1.6 px. The fit's sigmas say so honestly: each error is within 4
 // sigma of its own.
 TEST_CASE("target fit: a misaligned rig from boards held and laid on the floor, poses unknown",
-          "[calib][target]") {
+          "[calib][target][slow]") {
   const MirrorConfig truth = true_rig();
   const TargetGeometry target;  // 8 x 6 squares of 45 mm: an A3 sheet
   const std::vector<TargetView> views = observe(truth, target, 8, 16, 0.1, 3);
@@ -247,7 +247,7 @@ double worst_floor_range_error_m(const TargetFitResult &fitted, const MirrorConf
 // ranges are bent). Measured (8 held, 12 on the floor, seed 3): tilt errors -0.10 / -0.06
 // deg, sigma 0.07 deg; worst floor-range error at 2 m 3.0 mm, against 74 mm for the true rig
 // read as level. (The square rig's test above: the tilt held.)
-TEST_CASE("target fit: a rig off level is found from the boards on the floor", "[calib][target]") {
+TEST_CASE("target fit: a rig off level is found from the boards on the floor", "[calib][target][slow]") {
   MirrorConfig truth = true_rig();
   truth.rig.level_tilt_x_rad = 0.8 * kDeg;
   truth.rig.level_tilt_y_rad = -0.6 * kDeg;
