@@ -1,5 +1,6 @@
 #include "calibrate_command.hpp"
 
+#include "calibrate_level.hpp"
 #include "calibrate_target.hpp"
 
 #include <array>
@@ -124,6 +125,7 @@ void add_calibrate_command(CLI::App &app) {
   rim->add_option("--out", options->out, "YAML file to write (camera: {center_px: [u, v]})")->required();
   rim->callback([options] { run_rim(*options); });
   add_calibrate_target(*calibrate);
+  add_calibrate_level(*calibrate);
   auto *sensitivity = calibrate->add_subcommand(
       "sensitivity", "range error at 1, 2 and 4 m per unit error of each rig parameter (Markdown table)");
   auto config_file = std::make_shared<std::string>();
