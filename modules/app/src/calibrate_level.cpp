@@ -63,8 +63,7 @@ void report(const calib::LevelFitResult &fit, const Eigen::Vector2d &tilt, const
   const Eigen::Vector2d sigma = tilt_sigma(fit);
   std::printf(
       "\nlevel tilt: x %.4f deg, y %.4f deg, 1 sigma %.4f / %.4f deg (over %d image(s), %d of %d floor "
-      "contacts "
-      "fit the plane, their heights' robust scale %.1f mm); configured %.4f / %.4f deg\n",
+      "contacts fit the plane, their heights' robust scale %.1f mm); configured %.4f / %.4f deg\n",
       tilt.x() * kDeg, tilt.y() * kDeg, sigma.x() * kDeg, sigma.y() * kDeg, fit.frames, fit.inliers,
       fit.contacts, fit.residual_scale_m * 1e3, configured.x() * kDeg, configured.y() * kDeg);
   std::printf("floor by stereo: %.4f +- %.4f m below the pinhole (camera_height_m configured %.4f m)\n",

@@ -34,6 +34,7 @@ std::vector<Eigen::Vector3d> unambiguous_floor_contacts(const ScanReconstructor 
   const double floor_m = -reconstructor.config().camera_height_m;
   const LobeWork &inner = reconstructor.inner();
   const LobeWork &outer = reconstructor.outer();
+  const int capacity = reconstructor.config().stereo.floor.max_edges_per_column;
   std::vector<Eigen::Vector3d> contacts;
   for (const ScanPoint &p : scan.points) {
     if (p.elevated) continue;
@@ -51,9 +52,15 @@ std::vector<Eigen::Vector3d> unambiguous_floor_contacts(const ScanReconstructor 
     const std::optional<double> high = outer_row_at_height(model, p.inner_row, floor_m + reach_m);
     if (!low || !high) continue;
     const double first = std::min(*low, *high), last = std::max(*low, *high);
+    // The candidates run from the robot outwards (rows falling) up to the column's capacity:
+    // a full column that stops inside the window may hide a second edge there.
+    const auto outer_column = outer.candidates.column(p.column);
+    if (static_cast<int>(outer_column.size()) >= capacity && !outer_column.empty() &&
+        outer_column.back().row_subpx > first)
+      continue;
     const vision::EdgePoint *twin = nullptr;
     int found = 0;
-    for (const vision::EdgePoint &candidate : outer.candidates.column(p.column)) {
+    for (const vision::EdgePoint &candidate : outer_column) {
       if (candidate.row_subpx < first || candidate.row_subpx > last) continue;
       if (polarity(outer.edges, candidate.row, p.column) != sign) continue;
       twin = &candidate;
