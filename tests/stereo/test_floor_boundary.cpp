@@ -1,9 +1,12 @@
+#include <algorithm>
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <opencv2/imgcodecs.hpp>
+#include <vector>
 
 #include "omnislam/mirror/mirror_model.hpp"
 #include "omnislam/stereo/floor_geometry.hpp"
+#include "omnislam/stereo/floor_twins.hpp"
 #include "omnislam/stereo/scan_reconstructor.hpp"
 
 using omnislam::mirror::Lobe;
@@ -117,6 +120,28 @@ TEST_CASE("floor boundary on the convention image: one point per column at most,
   const omnislam::stereo::LocalScan nearest_scan = nearest.reconstruct(image);
   CHECK(nearest_scan.free_range_m.empty());
   CHECK(nearest_scan.points.size() > 100u);
+}
+
+TEST_CASE("floor contacts with unambiguous twins lie on the floor by stereo", "[stereo][floor][level]") {
+  const cv::Mat image = cv::imread(OMNISLAM_CONVENTION_IMAGE, cv::IMREAD_GRAYSCALE);
+  REQUIRE_FALSE(image.empty());
+  omnislam::stereo::ScanReconstructor reconstructor;
+  const omnislam::stereo::LocalScan scan = reconstructor.reconstruct(image);
+  REQUIRE(scan.status == omnislam::stereo::ScanStatus::kOk);
+  constexpr double kDegree = M_PI / 180.0;
+  const auto contacts = omnislam::stereo::unambiguous_floor_contacts(reconstructor, scan, 1.0 * kDegree);
+  CHECK(contacts.size() > 50u);
+  // Stereo puts them on the floor 1 m down (walls 3 m away: ~13 mm of height error each).
+  std::vector<double> errors;
+  for (const Eigen::Vector3d &p : contacts) errors.push_back(p.z() + 1.0);
+  const auto middle = errors.begin() + static_cast<std::ptrdiff_t>(errors.size() / 2);
+  std::nth_element(errors.begin(), middle, errors.end());
+  const double median = *middle;
+  for (double &e : errors) e = std::abs(e - median);
+  std::nth_element(errors.begin(), middle, errors.end());
+  CAPTURE(contacts.size(), median, *middle);
+  CHECK(std::abs(median) < 0.01);  // measured +4.6 mm
+  CHECK(*middle < 0.02);           // measured 6.9 mm
 }
 
 TEST_CASE("a frame of pure sensor noise gives no scan, and the convention image keeps its walls under noise",
