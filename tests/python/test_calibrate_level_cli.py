@@ -60,14 +60,16 @@ def test_calibrate_level_finds_a_rig_off_level(tmp_path):
     assert check.returncode == 0, check.stderr
 
 
-def test_calibrate_level_keeps_a_level_rig_level(tmp_path):
+def test_calibrate_level_keeps_a_level_rig_level_and_measures_the_height(tmp_path):
     # Measured (13 images): -0.026 / 0.003 +- 0.013 / 0.017 deg.
     out = tmp_path / "level.yaml"
     result = run("calibrate", "level", *every_third("sim-room-37"), "--config", level_config(tmp_path, "sim-room-37"),
-                 "--out", out)
+                 "--with-height", "--out", out)
     assert result.returncode == 0, result.stderr
     x, y = tilt_of(out)
     assert abs(x) < 0.05 and abs(y) < 0.05
+    # --with-height: the floor's depth by stereo, 1.0 m rendered (measured 0.9996 m).
+    assert abs(yaml.safe_load(out.read_text())["camera"]["camera_height_m"] - 1.0) < 0.003
 
 
 def test_calibrate_level_bad_input_is_named_and_nothing_written(tmp_path):

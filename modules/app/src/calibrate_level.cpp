@@ -30,6 +30,7 @@ struct LevelOptions {
   std::vector<std::string> images;
   std::string config;
   double max_tilt_deg = 1.0;
+  bool with_height = false;
   std::string out;
 };
 
@@ -142,9 +143,13 @@ void run_level(const LevelOptions &options) {
       "stereo %.4f m below the pinhole\n",
       fit.frames, fit.inliers, sigma.x() * kDeg, sigma.y() * kDeg, -fit.floor_z_m);
   out << text;
-  std::snprintf(text, sizeof text, "camera: {level_tilt_deg: [%.4f, %.4f]}\n", tilt.x() * kDeg,
-                tilt.y() * kDeg);
+  std::snprintf(text, sizeof text, "camera: {level_tilt_deg: [%.4f, %.4f]", tilt.x() * kDeg, tilt.y() * kDeg);
   out << text;
+  if (options.with_height) {
+    std::snprintf(text, sizeof text, ", camera_height_m: %.4f", -fit.floor_z_m);
+    out << text;
+  }
+  out << "}\n";
   if (!out) throw std::runtime_error(options.out + ": cannot write");
   const double elapsed_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   std::printf("wrote %s (%.1f s)\n", options.out.c_str(), elapsed_s);
@@ -164,6 +169,9 @@ void add_calibrate_level(CLI::App &calibrate) {
   command->add_option("--max-tilt-deg", options->max_tilt_deg,
                       "how far off the configured tilt the floor is looked for (default 1): a contact counts "
                       "when one outer edge alone lies where the floor could put it within this tilt");
+  command->add_flag("--with-height", options->with_height,
+                    "also write camera_height_m: the floor's depth below the pinhole by stereo with this rig "
+                    "(consistent with its mirror and focal length; a taped height is not)");
   command->add_option("--out", options->out, "YAML file to write (camera: {level_tilt_deg: [x, y]})")
       ->required();
   command->callback([options] { run_level(*options); });
