@@ -7,6 +7,8 @@
 #include <map>
 #include <vector>
 
+#include "omnislam/mirror/rig_model.hpp"
+
 namespace omnislam::calib {
 namespace {
 
@@ -40,9 +42,7 @@ Eigen::Vector3d tilt_of(const Eigen::Vector3d &plane, Eigen::Matrix3d &jacobian)
 }
 
 Eigen::Matrix3d level_rotation(const Eigen::Vector2d &tilt_rad) {
-  return (Eigen::AngleAxisd(tilt_rad.y(), Eigen::Vector3d::UnitY()) *
-          Eigen::AngleAxisd(tilt_rad.x(), Eigen::Vector3d::UnitX()))
-      .toRotationMatrix();
+  return mirror::level_rotation(tilt_rad.x(), tilt_rad.y());
 }
 
 }  // namespace

@@ -33,11 +33,9 @@ const std::vector<double> kHeightSteps(1, 1e-6);
 const std::vector<double> kLevelSteps(2, 1e-3);  // microradians (the block is in mrad)
 
 // The rig's level tilt block (mrad, RigConfig::level_tilt_*) as the rotation taking camera
-// coordinates to level ones (as RigModel builds it).
+// coordinates to level ones.
 Eigen::Matrix3d level_rotation(const double *level_mrad) {
-  return (Eigen::AngleAxisd(level_mrad[1] * 1e-3, Eigen::Vector3d::UnitY()) *
-          Eigen::AngleAxisd(level_mrad[0] * 1e-3, Eigen::Vector3d::UnitX()))
-      .toRotationMatrix();
+  return mirror::level_rotation(level_mrad[0] * 1e-3, level_mrad[1] * 1e-3);
 }
 
 // Where a board point is in the camera frame, from the pose's parameter blocks.

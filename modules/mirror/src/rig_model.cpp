@@ -50,14 +50,18 @@ double design_mirror_radius_mm(const MirrorModel &design, Lobe lobe, double radi
 
 }  // namespace
 
+Eigen::Matrix3d level_rotation(double tilt_x_rad, double tilt_y_rad) {
+  return (Eigen::AngleAxisd(tilt_y_rad, Eigen::Vector3d::UnitY()) *
+          Eigen::AngleAxisd(tilt_x_rad, Eigen::Vector3d::UnitX()))
+      .toRotationMatrix();
+}
+
 RigModel::RigModel(const MirrorConfig &config) : design_(config) {
   const RigConfig &rig = config.rig;
   rotation_ = (Eigen::AngleAxisd(rig.mirror_tilt_y_rad, Eigen::Vector3d::UnitY()) *
                Eigen::AngleAxisd(rig.mirror_tilt_x_rad, Eigen::Vector3d::UnitX()))
                   .toRotationMatrix();
-  level_ = (Eigen::AngleAxisd(rig.level_tilt_y_rad, Eigen::Vector3d::UnitY()) *
-            Eigen::AngleAxisd(rig.level_tilt_x_rad, Eigen::Vector3d::UnitX()))
-               .toRotationMatrix();
+  level_ = level_rotation(rig.level_tilt_x_rad, rig.level_tilt_y_rad);
   pivot_mm_ = Eigen::Vector3d(0.0, 0.0, design_.constants(Lobe::kInner).focus_z_mm);
   shift_mm_ = Eigen::Vector3d(rig.mirror_offset_x_mm, rig.mirror_offset_y_mm, rig.mirror_dz_mm);
   focal_px_ = rig.focal_scale * config.focal_mm / config.pixel_pitch_mm;
