@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "omnislam/calib/level_fit.hpp"
+#include "omnislam/mirror/rig_model.hpp"
 
 using omnislam::calib::FloorContact;
 using omnislam::calib::LevelFitResult;
@@ -13,12 +14,6 @@ using omnislam::calib::LevelFitResult;
 namespace {
 
 constexpr double kDeg = std::numbers::pi / 180.0;
-
-Eigen::Matrix3d level_rotation(double x_rad, double y_rad) {
-  return (Eigen::AngleAxisd(y_rad, Eigen::Vector3d::UnitY()) *
-          Eigen::AngleAxisd(x_rad, Eigen::Vector3d::UnitX()))
-      .toRotationMatrix();
-}
 
 // Floor contacts 0.5-4 m round a rig turned (tilt_x, tilt_y) off level, 1.0 m above the
 // floor, as the rig sees them (its frame): per frame 150 wall bases with `noise_m` of height
@@ -30,7 +25,7 @@ std::vector<FloorContact> contacts_of(double tilt_x, double tilt_y, int frames, 
   std::uniform_real_distribution<double> azimuth(0.0, 2.0 * std::numbers::pi), range(0.5, 4.0),
       unit(0.0, 1.0);
   std::normal_distribution<double> noise(0.0, noise_m), shared(0.0, frame_error_m);
-  const Eigen::Matrix3d camera_from_level = level_rotation(tilt_x, tilt_y).transpose();
+  const Eigen::Matrix3d camera_from_level = omnislam::mirror::tilt_rotation(tilt_x, tilt_y).transpose();
   std::vector<FloorContact> contacts;
   for (int frame = 0; frame < frames; ++frame) {
     const double offset = shared(random);
@@ -95,12 +90,12 @@ TEST_CASE("level fit: too few contacts or frames are said, not fitted", "[calib]
 TEST_CASE("level fit: composing tilts is the rotations' product", "[calib][level]") {
   const Eigen::Vector2d configured(0.5 * kDeg, -0.3 * kDeg), residual(0.2 * kDeg, 0.1 * kDeg);
   const Eigen::Vector2d composed = omnislam::calib::compose_level_tilt(configured, residual);
-  const Eigen::Matrix3d product =
-      level_rotation(residual.x(), residual.y()) * level_rotation(configured.x(), configured.y());
+  const Eigen::Matrix3d product = omnislam::mirror::tilt_rotation(residual.x(), residual.y()) *
+                                  omnislam::mirror::tilt_rotation(configured.x(), configured.y());
   // The composed pair turns the axis as the product does (a turn about the axis itself is
   // not a tilt).
   const Eigen::Vector3d axis =
-      level_rotation(composed.x(), composed.y()).transpose() * Eigen::Vector3d::UnitZ();
+      omnislam::mirror::tilt_rotation(composed.x(), composed.y()).transpose() * Eigen::Vector3d::UnitZ();
   CHECK((axis - product.transpose() * Eigen::Vector3d::UnitZ()).norm() < 1e-9);
   CHECK(composed.x() == Approx(0.7 * kDeg).epsilon(0.01));
   CHECK(composed.y() == Approx(-0.2 * kDeg).epsilon(0.02));

@@ -42,7 +42,7 @@ Eigen::Vector3d tilt_of(const Eigen::Vector3d &plane, Eigen::Matrix3d &jacobian)
 }
 
 Eigen::Matrix3d level_rotation(const Eigen::Vector2d &tilt_rad) {
-  return mirror::level_rotation(tilt_rad.x(), tilt_rad.y());
+  return mirror::tilt_rotation(tilt_rad.x(), tilt_rad.y());
 }
 
 }  // namespace

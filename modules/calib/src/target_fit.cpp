@@ -35,7 +35,7 @@ const std::vector<double> kLevelSteps(2, 1e-3);  // microradians (the block is i
 // The rig's level tilt block (mrad, RigConfig::level_tilt_*) as the rotation taking camera
 // coordinates to level ones.
 Eigen::Matrix3d level_rotation(const double *level_mrad) {
-  return mirror::level_rotation(level_mrad[0] * 1e-3, level_mrad[1] * 1e-3);
+  return mirror::tilt_rotation(level_mrad[0] * 1e-3, level_mrad[1] * 1e-3);
 }
 
 // Where a board point is in the camera frame, from the pose's parameter blocks.
@@ -414,13 +414,14 @@ TargetFitResult fit_target(const mirror::MirrorConfig &initial, const TargetGeom
   result.sigma.fill(kNaN);
   JointProblem joint;
   joint.rig = parameters_of(initial);
-  joint.level_mrad = {initial.rig.level_tilt_x_rad * 1e3, initial.rig.level_tilt_y_rad * 1e3};
+  const std::array<double, 2> configured_level_mrad{initial.rig.level_tilt_x_rad * 1e3,
+                                                    initial.rig.level_tilt_y_rad * 1e3};
+  joint.level_mrad = configured_level_mrad;
   joint.fit_level = config.fit_level;
   // Inside the fit the rig projects from its own (camera) frame: boards held anywhere are
   // placed there, boards on the floor are turned into it by the level block.
-  mirror::MirrorConfig camera_frame = initial;
-  camera_frame.rig.level_tilt_x_rad = camera_frame.rig.level_tilt_y_rad = 0.0;
-  const mirror::MirrorConfig &base = camera_frame;
+  mirror::MirrorConfig base = initial;
+  base.rig.level_tilt_x_rad = base.rig.level_tilt_y_rad = 0.0;
   start_views(joint, base, target, views, config, result);
   result.views_used = static_cast<int>(joint.views.size());
   if (result.views_used < 2) {
@@ -456,8 +457,7 @@ TargetFitResult fit_target(const mirror::MirrorConfig &initial, const TargetGeom
   double cost = 0.0;
   result.converged = solve(joint, config.max_iterations, result, &cost);
   if (result.converged && joint.fit_level && !std::isnan(joint.floor_z_m)) {
-    choose_level(joint, base, target, rim, config,
-                 {initial.rig.level_tilt_x_rad * 1e3, initial.rig.level_tilt_y_rad * 1e3}, cost, result);
+    choose_level(joint, base, target, rim, config, configured_level_mrad, cost, result);
   }
   result.level_fitted = joint.fit_level && !std::isnan(joint.floor_z_m);
   fill_result(joint, base, result);

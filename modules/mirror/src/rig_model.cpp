@@ -50,7 +50,7 @@ double design_mirror_radius_mm(const MirrorModel &design, Lobe lobe, double radi
 
 }  // namespace
 
-Eigen::Matrix3d level_rotation(double tilt_x_rad, double tilt_y_rad) {
+Eigen::Matrix3d tilt_rotation(double tilt_x_rad, double tilt_y_rad) {
   return (Eigen::AngleAxisd(tilt_y_rad, Eigen::Vector3d::UnitY()) *
           Eigen::AngleAxisd(tilt_x_rad, Eigen::Vector3d::UnitX()))
       .toRotationMatrix();
@@ -58,10 +58,8 @@ Eigen::Matrix3d level_rotation(double tilt_x_rad, double tilt_y_rad) {
 
 RigModel::RigModel(const MirrorConfig &config) : design_(config) {
   const RigConfig &rig = config.rig;
-  rotation_ = (Eigen::AngleAxisd(rig.mirror_tilt_y_rad, Eigen::Vector3d::UnitY()) *
-               Eigen::AngleAxisd(rig.mirror_tilt_x_rad, Eigen::Vector3d::UnitX()))
-                  .toRotationMatrix();
-  level_ = level_rotation(rig.level_tilt_x_rad, rig.level_tilt_y_rad);
+  rotation_ = tilt_rotation(rig.mirror_tilt_x_rad, rig.mirror_tilt_y_rad);
+  level_ = tilt_rotation(rig.level_tilt_x_rad, rig.level_tilt_y_rad);
   pivot_mm_ = Eigen::Vector3d(0.0, 0.0, design_.constants(Lobe::kInner).focus_z_mm);
   shift_mm_ = Eigen::Vector3d(rig.mirror_offset_x_mm, rig.mirror_offset_y_mm, rig.mirror_dz_mm);
   focal_px_ = rig.focal_scale * config.focal_mm / config.pixel_pitch_mm;

@@ -45,9 +45,10 @@ struct RayIntersection {
   double gap_m = 0.0;                                 ///< distance between the rays there
 };
 
-/// The rotation taking camera coordinates to the level frame of a rig turned off level by
-/// (tilt_x_rad, tilt_y_rad) (RigConfig::level_tilt_*: about x, then y, right-handed).
-[[nodiscard]] Eigen::Matrix3d level_rotation(double tilt_x_rad, double tilt_y_rad);
+/// A turn about x by tilt_x_rad, then about y by tilt_y_rad (right-handed): RigConfig's tilts
+/// (the mirror's, taking its design frame to the camera's; the whole rig's off level, taking
+/// camera coordinates to the level frame's).
+[[nodiscard]] Eigen::Matrix3d tilt_rotation(double tilt_x_rad, double tilt_y_rad);
 
 class RigModel {
  public:
